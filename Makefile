@@ -1,0 +1,63 @@
+# relume — `make demo` bakes the bundled scenes; `make test` installs what it needs and runs
+# every test. Everything builds in release mode once (tests share the build).
+
+CARGO    ?= cargo
+BAKE     := target/release/relume-bake
+PLAYER   := target/release/relume-player
+SUDO     := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth
+PY_PKGS  := pillow numpy openexr tifffile
+export WGPU_BACKEND ?= vulkan
+
+.PHONY: all build demo test deps deps-apt deps-py fmt lint bench study ci clean
+
+all: build
+
+build:
+	$(CARGO) build --release --locked
+
+## The main job on the bundled default: bake the Cornell box and Puget Sound.
+demo: build
+	@mkdir -p out/demo
+	$(BAKE) run pipelines/cornell.ron --out out/demo/cornell
+	$(BAKE) run pipelines/puget-sound.ron --out out/demo/puget-sound
+	$(BAKE) inspect out/demo/cornell
+	$(BAKE) inspect out/demo/puget-sound
+	@echo
+	@echo "demo output is in out/demo/"
+
+## Install what the tests need (software Vulkan, Python cross-check readers), then run them all.
+test: deps
+	$(CARGO) test --release --locked
+
+deps: deps-apt deps-py
+
+deps-apt:
+	@missing=""; for p in $(APT_PKGS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  if command -v apt-get >/dev/null 2>&1; then \
+	    echo "installing:$$missing"; \
+	    $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	    $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
+	  else echo "warning: not a Debian system; install$$missing by hand"; fi; \
+	fi
+
+deps-py:
+	@python3 -c "import PIL, numpy, OpenEXR, tifffile" 2>/dev/null || \
+	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) 2>&1 | grep -v "WARNING: Running pip as the 'root'" || true
+
+fmt:
+	$(CARGO) fmt --all
+
+lint:
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --release --all-targets -- -D warnings
+
+bench: build
+	$(CARGO) bench --locked
+
+ci: lint test
+
+clean:
+	$(CARGO) clean
+	rm -rf out

@@ -1,0 +1,248 @@
+//! Running a pipeline: load the input, check the plan against the memory budget, run each stage
+//! in order into a [`BakeTransaction`], write the manifest and swap the bake into place.
+
+use crate::baked::{self, manifest::hash_file, BakeTransaction, FileRecord, Manifest, StageRecord};
+use crate::error::{Error, Result};
+use crate::limits;
+use crate::load::{load_input, LoadedInput};
+use crate::pipeline::{plan, Pipeline, Stage};
+use crate::progress::Progress;
+use crate::workspace::Workspace;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Knobs of a bake that are not part of the pipeline (they do not change the output).
+#[derive(Clone, Debug)]
+pub struct BakeOptions {
+    /// Refuse to start when the estimated peak memory exceeds this many bytes.
+    pub max_memory: u64,
+}
+
+impl Default for BakeOptions {
+    fn default() -> Self {
+        BakeOptions {
+            max_memory: limits::default_max_memory(),
+        }
+    }
+}
+
+/// What a bake did, for people and `--json` (times live here, never in the manifest).
+#[derive(Clone, Debug, Serialize)]
+pub struct BakeReport {
+    pub output: PathBuf,
+    pub stages: Vec<StageTiming>,
+    pub files: Vec<FileRecord>,
+    pub warnings: Vec<String>,
+}
+
+/// Wall time and outputs of one stage.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageTiming {
+    pub stage: String,
+    pub seconds: f64,
+    pub outputs: Vec<String>,
+    pub report: std::collections::BTreeMap<String, f64>,
+}
+
+/// Bake `pipeline` into `output`. On any error nothing is written and a previous bake at
+/// `output` is left as it was.
+#[allow(unreachable_code, unused_variables, unused_mut)] // until the first stage lands
+pub fn run_pipeline(
+    pipeline: &Pipeline,
+    output: &Path,
+    opts: &BakeOptions,
+    progress: &dyn Progress,
+) -> Result<BakeReport> {
+    let t0 = Instant::now();
+    progress.begin("load", 0);
+    let input = load_input(&pipeline.input)?;
+    progress.finish();
+    let mut warnings = Vec::new();
+    if let LoadedInput::Scene(_, w) = &input {
+        for m in &w.messages {
+            progress.warn(m);
+            warnings.push(m.clone());
+        }
+    }
+    let the_plan = plan(pipeline, &input, output);
+    limits::check_memory("this bake", the_plan.peak_bytes, opts.max_memory)?;
+
+    let mut txn = BakeTransaction::begin(output)?;
+    let mut records = Vec::new();
+    let mut timings = Vec::new();
+    let load_record = write_input(&mut txn, &input)?;
+    timings.push(timing(&load_record, t0));
+    records.push(load_record);
+
+    let mut ws = Workspace::new();
+    match input {
+        LoadedInput::Scene(scene, _) => ws.set_scene(scene),
+        LoadedInput::HeightMap(map, _) => ws.set_heightmap(map),
+    }
+    for stage in &pipeline.stages {
+        let t = Instant::now();
+        let rec = stage.runner().run(&mut ws, &mut txn, progress)?;
+        timings.push(timing(&rec, t));
+        records.push(rec);
+    }
+
+    let (bytes, sha256) = hash_file(pipeline.input.path())?;
+    let input_name = pipeline
+        .input
+        .path()
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let manifest = Manifest {
+        format_version: baked::FORMAT_VERSION,
+        relume_version: env!("CARGO_PKG_VERSION").to_string(),
+        pipeline: pipeline.clone(),
+        input: FileRecord {
+            name: input_name,
+            bytes,
+            sha256,
+        },
+        stages: records,
+        files: Vec::new(),
+    };
+    let files = txn.files();
+    txn.commit(manifest)?;
+    Ok(BakeReport {
+        output: output.to_path_buf(),
+        stages: timings,
+        files,
+        warnings,
+    })
+}
+
+fn timing(record: &StageRecord, since: Instant) -> StageTiming {
+    StageTiming {
+        stage: record.stage.clone(),
+        seconds: since.elapsed().as_secs_f64(),
+        outputs: record.outputs.clone(),
+        report: record.report.clone(),
+    }
+}
+
+/// Store the input in its canonical baked form and describe it.
+fn write_input(txn: &mut BakeTransaction, input: &LoadedInput) -> Result<StageRecord> {
+    let mut rec = StageRecord {
+        stage: "load".into(),
+        ..Default::default()
+    };
+    match input {
+        LoadedInput::Scene(scene, _) => {
+            txn.write(baked::SCENE_FILE, &baked::to_postcard(scene)?)?;
+            rec.outputs.push(baked::SCENE_FILE.into());
+            rec.report
+                .insert("vertices".into(), scene.positions.len() as f64);
+            rec.report
+                .insert("triangles".into(), scene.triangles.len() as f64);
+            rec.report.insert(
+                "degenerate_triangles".into(),
+                scene.degenerate_triangles().count() as f64,
+            );
+            rec.report
+                .insert("materials".into(), scene.materials.len() as f64);
+            rec.report
+                .insert("lights".into(), scene.lights.len() as f64);
+            rec.facts.insert("grey".into(), scene.is_grey().to_string());
+        }
+        LoadedInput::HeightMap(map, info) => {
+            txn.write_with(baked::HEIGHTMAP_FILE, |p| baked::write_heightmap(p, map))?;
+            rec.outputs.push(baked::HEIGHTMAP_FILE.into());
+            let (lo, hi) = map.min_max();
+            rec.report.insert("width".into(), map.width as f64);
+            rec.report.insert("height".into(), map.height as f64);
+            rec.report.insert("cell_size_x".into(), map.cell_size[0]);
+            rec.report.insert("cell_size_y".into(), map.cell_size[1]);
+            rec.report.insert("height_scale".into(), map.height_scale);
+            rec.report.insert("min_height".into(), lo as f64);
+            rec.report.insert("max_height".into(), hi as f64);
+            rec.report
+                .insert("nodata_filled".into(), info.nodata_count as f64);
+            rec.facts.insert(
+                "source_format".into(),
+                format!("{} {}", info.format, info.sample),
+            );
+            rec.facts.insert("units".into(), "metres".into());
+        }
+    }
+    Ok(rec)
+}
+
+/// Run one stage alone on an existing bake at `dir`, replacing it atomically. Stages that come
+/// after `stage` in pipeline order are dropped from the bake (their inputs changed), and the
+/// manifest's pipeline is updated so that it still describes how to reproduce the bake.
+#[allow(unreachable_code, unused_variables)] // until the first stage lands
+pub fn run_stage_on(dir: &Path, stage: Stage, progress: &dyn Progress) -> Result<BakeReport> {
+    let manifest = Manifest::read(dir)?;
+    let kind = stage.kind();
+    let mpath = dir.join(baked::MANIFEST);
+    if kind.input_kind() != manifest.pipeline.input.kind() {
+        return Err(Error::input(
+            &mpath,
+            format!(
+                "stage `{}` works on a {} bake, this is a {} bake",
+                kind.name(),
+                kind.input_kind(),
+                manifest.pipeline.input.kind()
+            ),
+        ));
+    }
+    let mut pipeline = manifest.pipeline.clone();
+    pipeline.stages.retain(|s| s.kind() < kind);
+    if let Some(missing) = kind
+        .requires()
+        .iter()
+        .find(|r| !pipeline.stages.iter().any(|s| s.kind() == **r))
+    {
+        return Err(Error::input(
+            dir,
+            format!(
+                "stage `{}` needs `{}` to have run on this bake first",
+                kind.name(),
+                missing.name()
+            ),
+        ));
+    }
+    let kept: Vec<&StageRecord> = manifest
+        .stages
+        .iter()
+        .filter(|r| r.stage == "load" || pipeline.stages.iter().any(|s| s.kind().name() == r.stage))
+        .collect();
+    let mut txn = BakeTransaction::begin(dir)?;
+    for rec in &kept {
+        for f in &rec.outputs {
+            let file = manifest.file(f).ok_or_else(|| {
+                Error::verify(
+                    dir.join(f),
+                    "listed as a stage output but not in the manifest's files",
+                )
+            })?;
+            txn.carry(dir, file)?;
+        }
+    }
+    let mut records: Vec<StageRecord> = kept.into_iter().cloned().collect();
+    let mut ws = Workspace::over_bake(dir, manifest.clone());
+    let t = Instant::now();
+    let rec = stage.runner().run(&mut ws, &mut txn, progress)?;
+    let timings = vec![timing(&rec, t)];
+    records.push(rec);
+    pipeline.stages.push(stage);
+    let files = txn.files();
+    let new_manifest = Manifest {
+        pipeline,
+        stages: records,
+        files: Vec::new(),
+        ..manifest
+    };
+    txn.commit(new_manifest)?;
+    Ok(BakeReport {
+        output: dir.to_path_buf(),
+        stages: timings,
+        files,
+        warnings: Vec::new(),
+    })
+}

@@ -1,0 +1,301 @@
+//! File readers for height maps: each returns the raw samples (file units) and what the file says
+//! about no-data and cell size. Scaling and no-data policy are applied by the caller.
+
+use super::{HeightMapOptions, RawGrid};
+use crate::error::{Error, IoContext, Result};
+use std::path::Path;
+
+pub(super) fn read(path: &Path, opts: &HeightMapOptions) -> Result<RawGrid> {
+    let meta = std::fs::metadata(path).at(path, "cannot read height map")?;
+    if meta.is_dir() {
+        return Err(Error::input(
+            path,
+            "is a directory, expected a height map file",
+        ));
+    }
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") | Some("jpg") | Some("jpeg") => read_image(path),
+        Some("exr") => read_exr(path),
+        Some("tif") | Some("tiff") => read_tiff(path),
+        Some("raw") | Some("f32") => read_raw(path, opts.raw_size),
+        _ => Err(Error::unsupported(
+            path,
+            "unknown height-map format (expected .png, .jpg, .exr, .tif/.tiff, or .raw/.f32 with explicit size)",
+        )),
+    }
+}
+
+fn read_image(path: &Path) -> Result<RawGrid> {
+    use image::DynamicImage as D;
+    let reader = image::ImageReader::open(path).at(path, "cannot read height map")?;
+    let reader = reader
+        .with_guessed_format()
+        .at(path, "cannot read height map")?;
+    let format = match reader.format() {
+        Some(image::ImageFormat::Png) => "png",
+        Some(image::ImageFormat::Jpeg) => "jpeg",
+        Some(f) => {
+            return Err(Error::unsupported(
+                path,
+                format!(
+                    "{f:?} images are not supported as height maps (use PNG, JPEG, EXR or GeoTIFF)"
+                ),
+            ))
+        }
+        None => {
+            return Err(Error::input(
+                path,
+                "not a PNG or JPEG image (unrecognised file signature)",
+            ))
+        }
+    };
+    let img = reader.decode().map_err(|e| match e {
+        image::ImageError::IoError(io) => Error::io(path, "cannot read height map", io),
+        other => Error::input(path, format!("cannot decode {format}: {other}")),
+    })?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let (values, sample): (Vec<f64>, &'static str) = match &img {
+        D::ImageLuma8(b) => (b.as_raw().iter().map(|&v| v as f64).collect(), "u8"),
+        D::ImageLuma16(b) => (b.as_raw().iter().map(|&v| v as f64).collect(), "u16"),
+        D::ImageRgb8(b) => (equal_channels(path, b.as_raw(), 3, w)?, "u8"),
+        D::ImageRgb16(b) => (equal_channels(path, b.as_raw(), 3, w)?, "u16"),
+        D::ImageLumaA8(_) | D::ImageLumaA16(_) | D::ImageRgba8(_) | D::ImageRgba16(_) => {
+            return Err(Error::unsupported(
+                path,
+                "images with an alpha channel are not height maps; flatten to grayscale",
+            ))
+        }
+        other => {
+            return Err(Error::unsupported(
+                path,
+                format!("unsupported pixel type {:?}", other.color()),
+            ))
+        }
+    };
+    Ok(RawGrid {
+        width: w,
+        height: h,
+        values,
+        format,
+        sample,
+        nodata: None,
+        cell_size: None,
+    })
+}
+
+/// Take one channel of an RGB image whose channels are all equal; refuse real colour images.
+fn equal_channels<T: Copy + PartialEq + Into<f64>>(
+    path: &Path,
+    data: &[T],
+    n: usize,
+    width: usize,
+) -> Result<Vec<f64>> {
+    let mut out = Vec::with_capacity(data.len() / n);
+    for (i, px) in data.chunks_exact(n).enumerate() {
+        if px.iter().any(|c| *c != px[0]) {
+            let rgb: Vec<f64> = px.iter().map(|&c| c.into()).collect();
+            return Err(Error::input(
+                path,
+                format!(
+                    "colour image: channels differ at column {}, row {} ({rgb:?}); a height map must be grayscale or have equal R, G, B",
+                    i % width.max(1),
+                    i / width.max(1)
+                ),
+            ));
+        }
+        out.push(px[0].into());
+    }
+    Ok(out)
+}
+
+fn read_exr(path: &Path) -> Result<RawGrid> {
+    use exr::prelude::{read, FlatSamples, ReadChannels, ReadLayers};
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| match e {
+            exr::error::Error::Io(io) => Error::io(path, "cannot read height map", io),
+            other => Error::input(path, format!("cannot decode EXR: {other}")),
+        })?;
+    let layer = &image.layer_data;
+    let channels = &layer.channel_data.list;
+    let pick = if channels.len() == 1 {
+        0
+    } else if let Some(i) = channels
+        .iter()
+        .position(|c| matches!(c.name.to_string().as_str(), "Y" | "Z" | "H" | "height"))
+    {
+        i
+    } else {
+        let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+        return Err(Error::unsupported(
+            path,
+            format!("EXR has channels {names:?}; a height map needs a single channel (or one named Y, Z, H or height)"),
+        ));
+    };
+    let ch = &channels[pick];
+    let (sample, values): (&'static str, Vec<f64>) = match &ch.sample_data {
+        FlatSamples::F16(v) => ("f16", v.iter().map(|x| x.to_f64()).collect()),
+        FlatSamples::F32(v) => ("f32", v.iter().map(|&x| x as f64).collect()),
+        FlatSamples::U32(v) => ("u32", v.iter().map(|&x| x as f64).collect()),
+    };
+    let size = layer.size;
+    Ok(RawGrid {
+        width: size.width(),
+        height: size.height(),
+        values,
+        format: "exr",
+        sample,
+        nodata: None,
+        cell_size: None,
+    })
+}
+
+fn read_tiff(path: &Path) -> Result<RawGrid> {
+    use tiff::decoder::{Decoder, DecodingResult};
+    use tiff::tags::Tag;
+    use tiff::ColorType;
+    let file = std::fs::File::open(path).at(path, "cannot read height map")?;
+    let tiff_err = |e: tiff::TiffError| match e {
+        tiff::TiffError::IoError(io) => Error::io(path, "cannot read height map", io),
+        tiff::TiffError::UnsupportedError(u) => {
+            Error::unsupported(path, format!("unsupported TIFF: {u}"))
+        }
+        other => Error::input(path, format!("cannot decode TIFF: {other}")),
+    };
+    let mut dec = Decoder::new(std::io::BufReader::new(file)).map_err(tiff_err)?;
+    let (w, h) = dec.dimensions().map_err(tiff_err)?;
+    match dec.colortype().map_err(tiff_err)? {
+        ColorType::Gray(_) => {}
+        other => {
+            return Err(Error::unsupported(
+                path,
+                format!("TIFF pixel type {other:?}: a height map must have one sample per pixel"),
+            ))
+        }
+    }
+    let nodata = match dec.find_tag(Tag::GdalNodata) {
+        Ok(Some(v)) => v
+            .into_string()
+            .ok()
+            .and_then(|s| s.trim().trim_end_matches('\0').parse::<f64>().ok()),
+        _ => None,
+    };
+    let pixel_scale = match dec.find_tag(Tag::ModelPixelScaleTag) {
+        Ok(Some(v)) => v
+            .into_f64_vec()
+            .ok()
+            .filter(|s| s.len() >= 2 && s[0] > 0.0 && s[1] > 0.0)
+            .map(|s| [s[0], s[1]]),
+        _ => None,
+    };
+    let data = dec.read_image().map_err(tiff_err)?;
+    let (sample, values): (&'static str, Vec<f64>) = match data {
+        DecodingResult::U8(v) => ("u8", v.into_iter().map(f64::from).collect()),
+        DecodingResult::U16(v) => ("u16", v.into_iter().map(f64::from).collect()),
+        DecodingResult::I16(v) => ("i16", v.into_iter().map(f64::from).collect()),
+        DecodingResult::F32(v) => ("f32", v.into_iter().map(f64::from).collect()),
+        other => {
+            let kind = match other {
+                DecodingResult::U32(_) => "uint32",
+                DecodingResult::U64(_) => "uint64",
+                DecodingResult::I8(_) => "int8",
+                DecodingResult::I32(_) => "int32",
+                DecodingResult::I64(_) => "int64",
+                DecodingResult::F16(_) => "float16",
+                DecodingResult::F64(_) => "float64",
+                _ => "this",
+            };
+            return Err(Error::unsupported(
+                path,
+                format!("TIFF sample format {kind} is not supported (use int16, uint16, float32 or uint8)"),
+            ));
+        }
+    };
+    let cell_size = match read_world_file(path)? {
+        Some(c) => Some((c, "world-file")),
+        None => pixel_scale.map(|c| (c, "geotiff-tag")),
+    };
+    Ok(RawGrid {
+        width: w as usize,
+        height: h as usize,
+        values,
+        format: "geotiff",
+        sample,
+        nodata,
+        cell_size,
+    })
+}
+
+/// Cell size from an ESRI world file beside `path` (`.tfw`, or `.tifw`/`.wld`): six numbers
+/// A, D, B, E, C, F; the cell size is (|(A, D)|, |(B, E)|).
+fn read_world_file(path: &Path) -> Result<Option<[f64; 2]>> {
+    for ext in ["tfw", "tifw", "wld"] {
+        let wf = path.with_extension(ext);
+        let Ok(text) = std::fs::read_to_string(&wf) else {
+            continue;
+        };
+        let nums: Vec<f64> = text
+            .split_whitespace()
+            .filter_map(|t| t.parse().ok())
+            .collect();
+        if nums.len() != 6 {
+            return Err(Error::input(
+                &wf,
+                format!("a world file has six numbers, this one has {}", nums.len()),
+            ));
+        }
+        let cx = nums[0].hypot(nums[1]);
+        let cy = nums[2].hypot(nums[3]);
+        if !(cx > 0.0 && cy > 0.0 && cx.is_finite() && cy.is_finite()) {
+            return Err(Error::input(
+                &wf,
+                "the world file gives a zero or non-finite cell size",
+            ));
+        }
+        return Ok(Some([cx, cy]));
+    }
+    Ok(None)
+}
+
+fn read_raw(path: &Path, size: Option<[usize; 2]>) -> Result<RawGrid> {
+    let Some([w, h]) = size else {
+        return Err(Error::knob(format!(
+            "{}: a raw f32 height map needs its size: `raw_size: Some((W, H))` in the pipeline or `--raw-size WxH`",
+            path.display()
+        )));
+    };
+    let bytes = std::fs::read(path).at(path, "cannot read height map")?;
+    let expected = w.checked_mul(h).and_then(|n| n.checked_mul(4));
+    if expected != Some(bytes.len()) {
+        return Err(Error::input(
+            path,
+            format!(
+                "{w}x{h} f32 needs {} bytes, the file has {}",
+                w.saturating_mul(h).saturating_mul(4),
+                bytes.len()
+            ),
+        ));
+    }
+    let values = bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)
+        .collect();
+    Ok(RawGrid {
+        width: w,
+        height: h,
+        values,
+        format: "raw-f32",
+        sample: "f32",
+        nodata: None,
+        cell_size: None,
+    })
+}

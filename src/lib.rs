@@ -1,0 +1,19 @@
+//! relume: bake light offline and play it back in real time.
+//!
+//! The library does the work; the binaries (`relume-bake`, `relume-player`) parse arguments,
+//! show progress and print errors. Each pipeline stage is a module with one entry function over
+//! plain data. Start at [`pipeline`] (what a bake is), [`bake`] (how it runs) and [`baked`] (what
+//! it writes).
+
+pub mod bake;
+pub mod baked;
+pub mod error;
+pub mod heightmap;
+pub mod limits;
+pub mod load;
+pub mod pipeline;
+pub mod progress;
+pub mod scene;
+pub mod workspace;
+
+pub use error::{Error, Result};

@@ -1,0 +1,91 @@
+//! Resource limits: the memory budget a bake must fit in before it allocates.
+
+use crate::error::{Error, Result};
+
+/// Physical memory of this machine in bytes (Linux `/proc/meminfo`; 8 GiB when unknown).
+pub fn physical_memory() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("MemTotal:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map(|kb| kb * 1024)
+        .unwrap_or(8 << 30)
+}
+
+/// The default budget: 75 % of physical memory.
+pub fn default_max_memory() -> u64 {
+    physical_memory() / 4 * 3
+}
+
+/// Format a byte count for people (`1.5 GiB`).
+pub fn human_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = bytes as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{bytes} B")
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
+}
+
+/// Parse a human byte count: `512M`, `2G`, `1.5GiB`, `1000000`.
+pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
+    let t = s.trim();
+    let split = t.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a size (try 512M, 8G)"))?;
+    let mult = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 1u64,
+        "k" | "kb" | "kib" => 1 << 10,
+        "m" | "mb" | "mib" => 1 << 20,
+        "g" | "gb" | "gib" => 1 << 30,
+        "t" | "tb" | "tib" => 1 << 40,
+        other => {
+            return Err(format!(
+                "unknown unit `{other}` in `{s}` (use K, M, G or T)"
+            ))
+        }
+    };
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(format!("`{s}` is not a size"));
+    }
+    Ok((v * mult as f64) as u64)
+}
+
+/// Refuse work whose estimated peak memory exceeds the budget.
+pub fn check_memory(what: &str, estimate: u64, budget: u64) -> Result<()> {
+    if estimate > budget {
+        Err(Error::limit(format!(
+            "{what} needs about {} of memory, over the budget of {} (raise --max-memory, or reduce the patch count / map size)",
+            human_bytes(estimate),
+            human_bytes(budget)
+        )))
+    } else {
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn parses_sizes() {
+        assert_eq!(parse_bytes("512M").unwrap(), 512 << 20);
+        assert_eq!(parse_bytes("2G").unwrap(), 2 << 30);
+        assert_eq!(parse_bytes("1000").unwrap(), 1000);
+        assert!(parse_bytes("2X").is_err());
+        assert!(parse_bytes("lots").is_err());
+    }
+}

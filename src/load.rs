@@ -1,0 +1,130 @@
+//! Loading a pipeline's input (scene or height map) and summarising it for `relume-bake load`.
+
+use crate::error::{Error, Result};
+use crate::heightmap::{load_heightmap, HeightMap, HeightMapInfo, HeightMapOptions};
+use crate::pipeline::Input;
+use crate::scene::{load_scene, LoadWarnings, Scene, SceneOptions};
+use serde::Serialize;
+use std::path::Path;
+
+/// A loaded input with what its loader noticed.
+pub enum LoadedInput {
+    Scene(Scene, LoadWarnings),
+    HeightMap(HeightMap, HeightMapInfo),
+}
+
+/// Load the input a pipeline names.
+pub fn load_input(input: &Input) -> Result<LoadedInput> {
+    match input {
+        Input::Scene(s) => {
+            let (scene, warnings) = load_scene(&s.path, s.options())?;
+            Ok(LoadedInput::Scene(scene, warnings))
+        }
+        Input::HeightMap(h) => {
+            let (map, info) = load_heightmap(&h.path, &h.options())?;
+            Ok(LoadedInput::HeightMap(map, info))
+        }
+    }
+}
+
+/// Is this path a scene (by extension)?
+pub fn is_scene_path(path: &Path) -> bool {
+    matches!(
+        path.extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref(),
+        Some("obj") | Some("gltf") | Some("glb")
+    )
+}
+
+/// Summary of a scene for people and `--json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneSummary {
+    pub kind: &'static str,
+    pub path: String,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub degenerate_triangles: usize,
+    pub objects: Vec<String>,
+    pub materials: Vec<crate::scene::Material>,
+    pub lights: Vec<crate::scene::Light>,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+    pub total_area: f64,
+    pub grey: bool,
+    pub warnings: Vec<String>,
+}
+
+/// Summary of a height map for people and `--json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct HeightMapSummary {
+    pub kind: &'static str,
+    pub path: String,
+    pub width: usize,
+    pub height: usize,
+    pub cell_size: [f64; 2],
+    pub cell_size_source: String,
+    pub height_scale: f64,
+    pub min: f32,
+    pub max: f32,
+    pub nodata_count: usize,
+    pub format: String,
+    pub sample: String,
+}
+
+/// Summarise a loaded scene.
+pub fn summarize_scene(path: &Path, scene: &Scene, warnings: &LoadWarnings) -> SceneSummary {
+    let (lo, hi) = scene.bounds();
+    SceneSummary {
+        kind: "scene",
+        path: path.display().to_string(),
+        vertices: scene.positions.len(),
+        triangles: scene.triangles.len(),
+        degenerate_triangles: scene.degenerate_triangles().count(),
+        objects: scene.objects.clone(),
+        materials: scene.materials.clone(),
+        lights: scene.lights.clone(),
+        bounds_min: lo.to_array(),
+        bounds_max: hi.to_array(),
+        total_area: scene.total_area(),
+        grey: scene.is_grey(),
+        warnings: warnings.messages.clone(),
+    }
+}
+
+/// Summarise a loaded height map.
+pub fn summarize_heightmap(path: &Path, map: &HeightMap, info: &HeightMapInfo) -> HeightMapSummary {
+    let (min, max) = map.min_max();
+    HeightMapSummary {
+        kind: "heightmap",
+        path: path.display().to_string(),
+        width: map.width,
+        height: map.height,
+        cell_size: map.cell_size,
+        cell_size_source: info.cell_size_source.clone(),
+        height_scale: map.height_scale,
+        min,
+        max,
+        nodata_count: info.nodata_count,
+        format: info.format.clone(),
+        sample: info.sample.clone(),
+    }
+}
+
+/// Load a file for `relume-bake load`: a scene by extension, else a height map.
+pub fn load_any(
+    path: &Path,
+    scene: SceneOptions,
+    heightmap: &HeightMapOptions,
+) -> Result<LoadedInput> {
+    if is_scene_path(path) {
+        let (s, w) = load_scene(path, scene)?;
+        Ok(LoadedInput::Scene(s, w))
+    } else if path.extension().is_none() {
+        Err(Error::unsupported(path, "no file extension: cannot tell the format (scenes: .obj .gltf .glb; height maps: .png .jpg .exr .tif .raw)"))
+    } else {
+        let (m, i) = load_heightmap(path, heightmap)?;
+        Ok(LoadedInput::HeightMap(m, i))
+    }
+}

@@ -1,0 +1,100 @@
+//! `relume-bake plan`: the stages a pipeline would run, with estimated peak memory and output
+//! size, computed from the loaded input without writing anything. `run` checks the same estimate
+//! against `--max-memory` before it allocates.
+
+use super::{Pipeline, Stage};
+use crate::load::LoadedInput;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// What a pipeline would do.
+#[derive(Clone, Debug, Serialize)]
+pub struct Plan {
+    pub input: String,
+    pub input_kind: &'static str,
+    pub output: PathBuf,
+    pub stages: Vec<PlannedStage>,
+    /// The largest peak over all stages (stages run one after another).
+    pub peak_bytes: u64,
+    /// Total size of the baked directory.
+    pub output_bytes: u64,
+}
+
+/// One stage of a [`Plan`].
+#[derive(Clone, Debug, Serialize)]
+pub struct PlannedStage {
+    pub stage: String,
+    /// Estimated peak memory of the stage, in bytes, including what it keeps from earlier stages.
+    pub peak_bytes: u64,
+    /// Estimated bytes the stage writes.
+    pub output_bytes: u64,
+    /// What the estimate is based on.
+    pub notes: String,
+}
+
+/// Sizes that later stages' estimates depend on, updated stage by stage.
+#[derive(Clone, Debug, Default)]
+pub struct PlanState {
+    /// Bytes held in memory from earlier stages that later stages keep using.
+    pub resident_bytes: u64,
+    /// Triangles of a scene input.
+    pub triangles: u64,
+    /// Width and height of a height-map input.
+    pub map_size: (u64, u64),
+    /// Estimated patch count after voxelisation.
+    pub patches: u64,
+    /// Colour channels the transport needs (1 for grey scenes, 3 otherwise).
+    pub channels: u64,
+}
+
+/// Estimate the pipeline on a loaded input.
+pub fn plan(pipeline: &Pipeline, input: &LoadedInput, output: &Path) -> Plan {
+    let mut state = PlanState::default();
+    let load = match input {
+        LoadedInput::Scene(scene, _) => {
+            let v = scene.positions.len() as u64;
+            let t = scene.triangles.len() as u64;
+            state.triangles = t;
+            state.channels = if scene.is_grey() { 1 } else { 3 };
+            let bytes = v * 12 + t * 20 + scene.materials.len() as u64 * 64;
+            state.resident_bytes = bytes;
+            PlannedStage {
+                stage: "load".into(),
+                peak_bytes: bytes * 2,
+                output_bytes: bytes,
+                notes: format!("{v} vertices, {t} triangles"),
+            }
+        }
+        LoadedInput::HeightMap(map, _) => {
+            let texels = (map.width * map.height) as u64;
+            state.map_size = (map.width as u64, map.height as u64);
+            state.resident_bytes = texels * 4;
+            PlannedStage {
+                stage: "load".into(),
+                peak_bytes: texels * 13,
+                output_bytes: texels * 4,
+                notes: format!("{}x{} texels", map.width, map.height),
+            }
+        }
+    };
+    let mut stages = vec![load];
+    for stage in &pipeline.stages {
+        stages.push(estimate(stage, &mut state));
+    }
+    Plan {
+        input: pipeline.input.path().display().to_string(),
+        input_kind: pipeline.input.kind(),
+        output: output.to_path_buf(),
+        peak_bytes: stages.iter().map(|s| s.peak_bytes).max().unwrap_or(0),
+        output_bytes: stages.iter().map(|s| s.output_bytes).sum(),
+        stages,
+    }
+}
+
+fn estimate(stage: &Stage, state: &mut PlanState) -> PlannedStage {
+    // A stage's own estimate covers its working memory; what earlier stages keep resident adds.
+    let resident = state.resident_bytes;
+    let mut planned = stage.runner().estimate(state);
+    planned.peak_bytes += resident;
+    planned
+}

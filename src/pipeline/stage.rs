@@ -1,0 +1,101 @@
+//! The stages a pipeline can list, with their knobs, and the rules of their order.
+
+use super::plan::{PlanState, PlannedStage};
+use super::Pipeline;
+use crate::baked::{BakeTransaction, StageRecord};
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::workspace::Workspace;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// What every stage's knob struct implements: run over a [`Workspace`], and estimate its cost.
+pub trait StageRun {
+    /// Run the stage: take inputs from `ws`, write files into `txn`, leave artifacts in `ws` for
+    /// later stages, and return the record (outputs and deterministic measurements).
+    fn run(
+        &self,
+        ws: &mut Workspace,
+        txn: &mut BakeTransaction,
+        progress: &dyn Progress,
+    ) -> Result<StageRecord>;
+
+    /// Estimate peak memory and output bytes, updating `state` for later stages.
+    fn estimate(&self, state: &mut PlanState) -> PlannedStage;
+}
+
+/// One stage of a pipeline with its knobs. Each variant's knobs live beside the stage's code.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Stage {}
+
+/// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
+/// alone on a bake invalidates the stages that come after it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum StageKind {}
+
+impl Stage {
+    /// Which stage this is.
+    pub fn kind(&self) -> StageKind {
+        match *self {}
+    }
+
+    /// The stage's implementation.
+    pub fn runner(&self) -> &dyn StageRun {
+        match *self {}
+    }
+}
+
+impl StageKind {
+    /// The name used in pipeline files and the manifest.
+    pub fn name(self) -> &'static str {
+        match self {}
+    }
+
+    /// The input kind the stage works on (`"scene"` or `"heightmap"`).
+    pub fn input_kind(self) -> &'static str {
+        match self {}
+    }
+
+    /// Stages that must have run before this one (in this pipeline or an earlier bake).
+    pub fn requires(self) -> &'static [StageKind] {
+        match self {}
+    }
+}
+
+/// Check that every stage fits the input kind and comes after the stages it needs.
+#[allow(unreachable_code, unused_variables, unused_mut)] // until the first stage lands
+pub(super) fn check_order(path: &Path, pipeline: &Pipeline) -> Result<()> {
+    let mut done: Vec<StageKind> = Vec::new();
+    for stage in &pipeline.stages {
+        let kind = stage.kind();
+        if kind.input_kind() != pipeline.input.kind() {
+            return Err(Error::input(
+                path,
+                format!(
+                    "stage `{}` works on a {} input, but this pipeline's input is a {}",
+                    kind.name(),
+                    kind.input_kind(),
+                    pipeline.input.kind()
+                ),
+            ));
+        }
+        if let Some(missing) = kind.requires().iter().find(|r| !done.contains(r)) {
+            return Err(Error::input(
+                path,
+                format!(
+                    "stage `{}` needs `{}` before it; add it earlier in `stages`",
+                    kind.name(),
+                    missing.name()
+                ),
+            ));
+        }
+        if done.contains(&kind) {
+            return Err(Error::input(
+                path,
+                format!("stage `{}` appears twice", kind.name()),
+            ));
+        }
+        done.push(kind);
+    }
+    Ok(())
+}

@@ -1,0 +1,287 @@
+//! The plain scene description every loader produces (pbrt-v4 style: parsing first, building
+//! later): world-space triangles with a material and a source object each, diffuse materials with
+//! emission, and punctual lights. Nothing here knows about patches, BVHs or GPUs.
+//!
+//! Conventions (README "Conventions"): right-handed, y up; units are whatever the file uses,
+//! multiplied by the pipeline's `scale` knob (the bundled Cornell box is in millimetres);
+//! front faces wind counter-clockwise; emission is radiance L (W·m⁻²·sr⁻¹, OBJ `Ke`).
+
+mod gltf_loader;
+mod obj_loader;
+
+use crate::error::{Error, Result};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// A diffuse material: albedo (reflectance, linear RGB in [0, 1]) and emitted radiance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    pub name: String,
+    /// Diffuse reflectance ρ per channel, linear RGB, each in [0, 1].
+    pub albedo: [f32; 3],
+    /// Emitted radiance L per channel (W·m⁻²·sr⁻¹). The exitance of a Lambertian emitter is π·L.
+    pub emission: [f32; 3],
+}
+
+impl Material {
+    /// The material used when a file names none (or its MTL is missing): 50 % grey, no emission.
+    pub fn default_grey() -> Self {
+        Material {
+            name: "default".into(),
+            albedo: [0.5; 3],
+            emission: [0.0; 3],
+        }
+    }
+
+    /// True when the material emits light in any channel.
+    pub fn is_emissive(&self) -> bool {
+        self.emission.iter().any(|&e| e > 0.0)
+    }
+}
+
+/// The kind of a punctual light (KHR_lights_punctual semantics).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum LightKind {
+    /// Light along `direction` from infinitely far away; intensity in lux (lm/m²).
+    Directional,
+    /// Light from `position` in all directions; intensity in candela (lm/sr).
+    Point,
+    /// A point light restricted to a cone around `direction` (angles in radians).
+    Spot { inner_cone: f32, outer_cone: f32 },
+}
+
+/// A punctual light in world space.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Light {
+    pub name: String,
+    pub kind: LightKind,
+    pub position: [f32; 3],
+    /// Unit direction the light travels (for directional and spot lights).
+    pub direction: [f32; 3],
+    /// Linear RGB colour.
+    pub color: [f32; 3],
+    /// Candela for point and spot lights, lux for directional lights.
+    pub intensity: f32,
+    /// Range beyond which a point or spot light has no effect (None = infinite).
+    pub range: Option<f32>,
+}
+
+/// A triangle mesh scene in world space.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Scene {
+    /// World-space vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Vertex indices of each triangle, counter-clockwise front faces.
+    pub triangles: Vec<[u32; 3]>,
+    /// Material index of each triangle (into `materials`).
+    pub triangle_material: Vec<u32>,
+    /// Source object index of each triangle (into `objects`).
+    pub triangle_object: Vec<u32>,
+    /// Names of the source objects (OBJ `o`/`g`, glTF mesh or node names).
+    pub objects: Vec<String>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+}
+
+/// What a loader noticed but did not treat as an error.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct LoadWarnings {
+    pub messages: Vec<String>,
+}
+
+impl LoadWarnings {
+    pub fn push(&mut self, m: impl Into<String>) {
+        self.messages.push(m.into());
+    }
+}
+
+/// Load options shared by every scene format.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneOptions {
+    /// Multiply every position by this factor (e.g. 0.001 for millimetres to metres).
+    pub scale: f32,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        SceneOptions { scale: 1.0 }
+    }
+}
+
+/// Load an OBJ (+MTL), glTF or GLB scene, chosen by extension.
+///
+/// Errors name `path`. Non-finite positions are errors; degenerate (zero-area) triangles are
+/// kept in the scene — later stages skip and count them — and reported among the warnings.
+pub fn load_scene(path: &Path, opts: SceneOptions) -> Result<(Scene, LoadWarnings)> {
+    if !(opts.scale.is_finite() && opts.scale > 0.0) {
+        return Err(Error::knob(format!(
+            "scene scale must be a positive finite number, got {}",
+            opts.scale
+        )));
+    }
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let mut warnings = LoadWarnings::default();
+    let mut scene = match ext.as_deref() {
+        Some("obj") => obj_loader::load(path, &mut warnings)?,
+        Some("gltf") | Some("glb") => gltf_loader::load(path, &mut warnings)?,
+        _ => {
+            return Err(Error::unsupported(
+                path,
+                "unknown scene format (expected .obj, .gltf or .glb)",
+            ))
+        }
+    };
+    if opts.scale != 1.0 {
+        for p in &mut scene.positions {
+            for c in p.iter_mut() {
+                *c *= opts.scale;
+            }
+        }
+        for l in &mut scene.lights {
+            for c in l.position.iter_mut() {
+                *c *= opts.scale;
+            }
+            l.range = l.range.map(|r| r * opts.scale);
+        }
+    }
+    scene.validate(path)?;
+    let degenerate = scene.degenerate_triangles().count();
+    if degenerate > 0 {
+        warnings.push(format!(
+            "{degenerate} degenerate (zero-area) triangle(s) will be ignored by the bake"
+        ));
+    }
+    Ok((scene, warnings))
+}
+
+impl Scene {
+    /// Check the invariants every later stage relies on; errors name `path`.
+    pub fn validate(&self, path: &Path) -> Result<()> {
+        if self.triangles.is_empty() {
+            return Err(Error::input(path, "the scene has no triangles"));
+        }
+        if let Some((i, p)) = self
+            .positions
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(Error::input(
+                path,
+                format!("vertex {} has a non-finite coordinate {:?}", i + 1, p),
+            ));
+        }
+        let n = self.positions.len() as u32;
+        if let Some((t, tri)) = self
+            .triangles
+            .iter()
+            .enumerate()
+            .find(|(_, t)| t.iter().any(|&v| v >= n))
+        {
+            return Err(Error::input(
+                path,
+                format!("triangle {t} refers to vertex {tri:?}, but there are only {n} vertices"),
+            ));
+        }
+        let nm = self.materials.len() as u32;
+        if self.triangle_material.len() != self.triangles.len()
+            || self.triangle_object.len() != self.triangles.len()
+            || self.triangle_material.iter().any(|&m| m >= nm)
+            || self
+                .triangle_object
+                .iter()
+                .any(|&o| o as usize >= self.objects.len())
+        {
+            return Err(Error::Internal(format!(
+                "{}: loader produced inconsistent material/object indices",
+                path.display()
+            )));
+        }
+        for m in &self.materials {
+            if m.albedo
+                .iter()
+                .chain(&m.emission)
+                .any(|c| !c.is_finite() || *c < 0.0)
+            {
+                return Err(Error::input(
+                    path,
+                    format!("material `{}` has a negative or non-finite colour", m.name),
+                ));
+            }
+            if m.albedo.iter().any(|&c| c > 1.0) {
+                return Err(Error::input(
+                    path,
+                    format!(
+                        "material `{}` has albedo {:?} above 1: a diffuse surface cannot reflect more light than it receives",
+                        m.name, m.albedo
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The three corners of triangle `t`.
+    pub fn corners(&self, t: usize) -> [Vec3; 3] {
+        self.triangles[t].map(|v| Vec3::from(self.positions[v as usize]))
+    }
+
+    /// Area of triangle `t`.
+    pub fn triangle_area(&self, t: usize) -> f32 {
+        let [a, b, c] = self.corners(t);
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// Indices of triangles whose area is zero (or not a normal number) relative to their size.
+    pub fn degenerate_triangles(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.triangles.len()).filter(move |&t| {
+            let [a, b, c] = self.corners(t);
+            let cross = (b - a).cross(c - a).length();
+            let scale = (b - a).length_squared().max((c - a).length_squared());
+            cross.partial_cmp(&(scale * 1e-12)) != Some(std::cmp::Ordering::Greater)
+                || !cross.is_normal()
+        })
+    }
+
+    /// Axis-aligned bounds (min, max) of all vertices referenced by triangles.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for tri in &self.triangles {
+            for &v in tri {
+                let p = Vec3::from(self.positions[v as usize]);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Total surface area of all triangles.
+    pub fn total_area(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| self.triangle_area(t) as f64)
+            .sum()
+    }
+
+    /// True when every material is grey (R = G = B albedo): one colour channel suffices for the
+    /// transport matrix.
+    pub fn is_grey(&self) -> bool {
+        self.materials
+            .iter()
+            .all(|m| m.albedo[0] == m.albedo[1] && m.albedo[1] == m.albedo[2])
+    }
+
+    /// Index of a material with this name, adding it when absent.
+    pub(crate) fn material_index(&mut self, m: Material) -> u32 {
+        if let Some(i) = self.materials.iter().position(|x| *x == m) {
+            return i as u32;
+        }
+        self.materials.push(m);
+        (self.materials.len() - 1) as u32
+    }
+}
