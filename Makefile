@@ -8,6 +8,8 @@ SUDO     := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth
 PY_PKGS  := pillow numpy openexr tifffile
 export WGPU_BACKEND ?= vulkan
+# Mesa warns without a private runtime dir; give it one.
+export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
 
 .PHONY: all build demo test deps deps-apt deps-py fmt lint bench study ci clean
 
@@ -28,6 +30,7 @@ demo: build
 
 ## Install what the tests need (software Vulkan, Python cross-check readers), then run them all.
 test: deps
+	@mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
 	$(CARGO) test --release --locked
 
 deps: deps-apt deps-py

@@ -72,6 +72,10 @@ pub enum Error {
     #[error("{}: {message}", path.display())]
     Verify { path: PathBuf, message: String },
 
+    /// No usable GPU (adapter or device), with the fix to try.
+    #[error("{0}")]
+    Gpu(String),
+
     /// A bug in relume.
     #[error("internal error: {0}")]
     Internal(String),
@@ -134,7 +138,7 @@ impl Error {
             Error::Input { .. } | Error::Knob { .. } | Error::Located { .. } => exit::INPUT,
             Error::Io { .. } => exit::IO,
             Error::Limit { .. } => exit::LIMIT,
-            Error::Unsupported { .. } => exit::UNSUPPORTED,
+            Error::Unsupported { .. } | Error::Gpu(_) => exit::UNSUPPORTED,
             Error::Verify { .. } => exit::VERIFY,
             Error::Internal(_) => exit::INTERNAL,
         }
@@ -150,6 +154,7 @@ impl Error {
             Error::Io { .. } => "io",
             Error::Limit { .. } => "limit",
             Error::Unsupported { .. } => "unsupported",
+            Error::Gpu(_) => "gpu",
             Error::Verify { .. } => "verify",
             Error::Internal(_) => "internal",
         }

@@ -8,11 +8,13 @@
 pub mod bake;
 pub mod baked;
 pub mod error;
+pub mod gpu;
 pub mod heightmap;
 pub mod limits;
 pub mod load;
 pub mod pipeline;
 pub mod progress;
+pub mod render;
 pub mod scene;
 pub mod workspace;
 

@@ -1,0 +1,177 @@
+//! wgpu device, shader loading and readback. Every WGSL kernel in `shaders/` has a Rust twin in
+//! the library that tests compare it with (on Mesa's lavapipe in CI).
+//!
+//! Shaders share types through `shaders/common.wgsl`, which is prepended to every kernel's source
+//! (WGSL has no includes); [`shader_source`] does the concatenation for the device and the naga
+//! validation test alike.
+
+pub mod compute;
+pub mod readback;
+pub mod timing;
+
+use crate::error::{Error, Result};
+use serde::Serialize;
+
+/// A GPU device with its queue and what the adapter offers.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter: wgpu::Adapter,
+    pub info: AdapterReport,
+}
+
+/// What relume reports about the adapter it uses.
+#[derive(Clone, Debug, Serialize)]
+pub struct AdapterReport {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    /// Hardware BC1..BC7 texture sampling is available.
+    pub bc_textures: bool,
+    /// GPU timestamp queries are available (per-pass GPU times in frames.json).
+    pub timestamps: bool,
+    pub max_texture_dimension_2d: u32,
+    pub max_storage_buffer_binding_size: u64,
+}
+
+/// Which graphics API to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub enum BackendChoice {
+    Vulkan,
+    Gl,
+    Metal,
+    Dx12,
+}
+
+impl BackendChoice {
+    fn backends(self) -> wgpu::Backends {
+        match self {
+            BackendChoice::Vulkan => wgpu::Backends::VULKAN,
+            BackendChoice::Gl => wgpu::Backends::GL,
+            BackendChoice::Metal => wgpu::Backends::METAL,
+            BackendChoice::Dx12 => wgpu::Backends::DX12,
+        }
+    }
+}
+
+/// The fix to suggest when no adapter exists.
+pub const NO_ADAPTER_HINT: &str =
+    "no GPU adapter found. On Debian/Ubuntu install the software Vulkan driver: \
+     `sudo apt-get install mesa-vulkan-drivers libvulkan1` (or `make deps`); \
+     or try `--backend gl` with `libegl1 libegl-mesa0 libgl1-mesa-dri`";
+
+impl Gpu {
+    /// Open a device. `backend` None means `WGPU_BACKEND` from the environment, else Vulkan
+    /// then GL. Requests BC textures and timestamp queries when the adapter has them.
+    pub fn new(backend: Option<BackendChoice>) -> Result<Gpu> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        match backend {
+            Some(b) => desc.backends = b.backends(),
+            None if std::env::var_os("WGPU_BACKEND").is_none() => {
+                desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL
+            }
+            None => {}
+        }
+        let instance = wgpu::Instance::new(desc);
+        Self::from_instance(&instance, None)
+    }
+
+    /// Open a device on `instance`, compatible with `surface` when given.
+    pub fn from_instance(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Gpu> {
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: surface,
+            ..Default::default()
+        }))
+        .map_err(|e| Error::Gpu(format!("{NO_ADAPTER_HINT} ({e})")))?;
+        let offered = adapter.features();
+        let wanted = wgpu::Features::TEXTURE_COMPRESSION_BC | wgpu::Features::TIMESTAMP_QUERY;
+        let required_features = offered & wanted;
+        let alimits = adapter.limits();
+        let required_limits = wgpu::Limits {
+            max_storage_buffer_binding_size: alimits.max_storage_buffer_binding_size,
+            max_buffer_size: alimits.max_buffer_size,
+            max_texture_dimension_2d: alimits.max_texture_dimension_2d,
+            max_compute_workgroup_storage_size: alimits.max_compute_workgroup_storage_size,
+            max_storage_buffers_per_shader_stage: alimits
+                .max_storage_buffers_per_shader_stage
+                .min(16),
+            ..wgpu::Limits::downlevel_defaults().using_resolution(alimits.clone())
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("relume"),
+            required_features,
+            required_limits,
+            ..Default::default()
+        }))
+        .map_err(|e| Error::Gpu(format!("the adapter refused a device: {e}")))?;
+        let ai = adapter.get_info();
+        let limits = device.limits();
+        let info = AdapterReport {
+            name: ai.name.clone(),
+            backend: format!("{:?}", ai.backend),
+            device_type: format!("{:?}", ai.device_type),
+            driver: format!("{} {}", ai.driver, ai.driver_info),
+            bc_textures: required_features.contains(wgpu::Features::TEXTURE_COMPRESSION_BC),
+            timestamps: required_features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            max_texture_dimension_2d: limits.max_texture_dimension_2d,
+            max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
+        };
+        Ok(Gpu {
+            device,
+            queue,
+            adapter,
+            info,
+        })
+    }
+
+    /// Compile a kernel from `shaders/` (with `common.wgsl` prepended), turning validation
+    /// errors into [`Error::Internal`] instead of a panic.
+    pub fn shader(&self, name: &str) -> Result<wgpu::ShaderModule> {
+        let source = shader_source(name)?;
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Internal(format!("shader {name}: {e}")));
+        }
+        Ok(module)
+    }
+
+    /// Wait for all submitted work.
+    pub fn wait(&self) {
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
+/// The WGSL kernels, by file name, embedded at compile time.
+pub const SHADERS: &[(&str, &str)] = &[
+    ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    (
+        "tonemap_test.wgsl",
+        include_str!("../../shaders/tonemap_test.wgsl"),
+    ),
+];
+
+/// Full source of a kernel: `common.wgsl` followed by the kernel.
+pub fn shader_source(name: &str) -> Result<String> {
+    let common = SHADERS[0].1;
+    let body = SHADERS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .ok_or_else(|| Error::Internal(format!("no shader named {name}")))?;
+    if name == "common.wgsl" {
+        return Ok(common.to_string());
+    }
+    Ok(format!("{common}\n{body}"))
+}
