@@ -13,6 +13,7 @@ pub mod heightmap;
 pub mod limits;
 pub mod load;
 pub mod pipeline;
+pub mod player;
 pub mod progress;
 pub mod render;
 pub mod scene;

@@ -5,7 +5,9 @@
 //! (WGSL has no includes); [`shader_source`] does the concatenation for the device and the naga
 //! validation test alike.
 
+pub mod blit;
 pub mod compute;
+pub mod mesh_renderer;
 pub mod readback;
 pub mod timing;
 
@@ -153,25 +155,52 @@ impl Gpu {
     }
 }
 
-/// The WGSL kernels, by file name, embedded at compile time.
+/// The WGSL files of `shaders/`, by file name, embedded at compile time.
 pub const SHADERS: &[(&str, &str)] = &[
+    ("blit.wgsl", include_str!("../../shaders/blit.wgsl")),
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    ("lighting.wgsl", include_str!("../../shaders/lighting.wgsl")),
+    (
+        "mesh_shade.wgsl",
+        include_str!("../../shaders/mesh_shade.wgsl"),
+    ),
+    (
+        "shadow_depth.wgsl",
+        include_str!("../../shaders/shadow_depth.wgsl"),
+    ),
     (
         "tonemap_test.wgsl",
         include_str!("../../shaders/tonemap_test.wgsl"),
     ),
 ];
 
-/// Full source of a kernel: `common.wgsl` followed by the kernel.
-pub fn shader_source(name: &str) -> Result<String> {
-    let common = SHADERS[0].1;
-    let body = SHADERS
+fn raw_source(name: &str) -> Result<(&'static str, &'static str)> {
+    SHADERS
         .iter()
         .find(|(n, _)| *n == name)
-        .map(|(_, s)| *s)
-        .ok_or_else(|| Error::Internal(format!("no shader named {name}")))?;
+        .copied()
+        .ok_or_else(|| Error::Internal(format!("no shader named {name}")))
+}
+
+/// Full source of a kernel: `common.wgsl`, then every file named by a `//! include NAME` line
+/// (in order, each once), then the kernel itself.
+pub fn shader_source(name: &str) -> Result<String> {
+    let (_, common) = raw_source("common.wgsl")?;
     if name == "common.wgsl" {
         return Ok(common.to_string());
     }
-    Ok(format!("{common}\n{body}"))
+    let (_, body) = raw_source(name)?;
+    let mut out = String::from(common);
+    let mut included = vec!["common.wgsl"];
+    for line in body.lines() {
+        if let Some(inc) = line.trim().strip_prefix("//! include ") {
+            let (inc_name, inc_body) = raw_source(inc.trim())?;
+            if !included.contains(&inc_name) {
+                out.push_str(&format!("\n// ---- {inc_name}\n{inc_body}"));
+                included.push(inc_name);
+            }
+        }
+    }
+    out.push_str(&format!("\n// ---- {name}\n{body}"));
+    Ok(out)
 }

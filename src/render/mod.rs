@@ -1,3 +1,6 @@
 //! CPU reference renderer and the pieces shared with the GPU player (camera, tone mapping).
 
+pub mod camera;
+pub mod lights;
+pub mod mesh_reference;
 pub mod tonemap;

@@ -1,0 +1,80 @@
+// Final shading of the full mesh: direct light from punctual lights (shadow maps, per pixel),
+// indirect light transferred from the patches (per corner, interpolated), emission, tone map.
+// Rust twin: relume::render::mesh_reference (CPU ray caster with BVH visibility).
+//! include lighting.wgsl
+
+struct Frame {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    exposure: f32,
+    emission_scale: f32,
+    flags: u32,        // bit 0 direct, bit 1 indirect, bit 2 shadows, bit 3 emission
+    _pad: u32,
+}
+@group(0) @binding(0) var<uniform> frame: Frame;
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) albedo: vec3<f32>,
+    @location(3) emission: vec3<f32>,
+    @location(4) indirect: vec3<f32>,
+}
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) albedo: vec3<f32>,
+    @location(3) emission: vec3<f32>,
+    @location(4) indirect: vec3<f32>,
+}
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    var o: VertexOut;
+    o.clip = frame.view_proj * vec4<f32>(v.position, 1.0);
+    o.world = v.position;
+    o.normal = v.normal;
+    o.albedo = v.albedo;
+    o.emission = v.emission;
+    o.indirect = v.indirect;
+    return o;
+}
+
+// Outgoing radiance of a Lambertian point: the twin of relume::render::mesh_reference::shade.
+fn shade_point(p: vec3<f32>, n_in: vec3<f32>, albedo: vec3<f32>, emission: vec3<f32>, indirect: vec3<f32>) -> vec3<f32> {
+    var n = normalize(n_in);
+    var radiance = vec3<f32>(0.0);
+    if ((frame.flags & 1u) != 0u) {
+        var h = vec3<f32>(0.0);
+        for (var i = 0u; i < min(lights.count, MAX_LIGHTS); i = i + 1u) {
+            let light = lights.lights[i];
+            let inc = light_irradiance(light, p, n);
+            var vis = 1.0;
+            if ((frame.flags & 4u) != 0u && any(inc.irradiance > vec3<f32>(0.0))) {
+                vis = shadow_visibility(light, p, n);
+            }
+            h = h + inc.irradiance * vis;
+        }
+        radiance = radiance + albedo / PI * h;
+    }
+    if ((frame.flags & 2u) != 0u) {
+        radiance = radiance + indirect / PI;
+    }
+    if ((frame.flags & 8u) != 0u) {
+        radiance = radiance + emission * frame.emission_scale;
+    }
+    return radiance;
+}
+
+@fragment
+fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    // Two-sided: light the side facing the viewer (open scenes show back faces).
+    var n = normalize(v.normal);
+    if (!front) {
+        n = -n;
+    }
+    let radiance = shade_point(v.world, n, v.albedo, v.emission, v.indirect);
+    return vec4<f32>(tonemap(radiance, frame.exposure), 1.0);
+}

@@ -1,0 +1,356 @@
+//! The interactive window (winit): orbit camera, sun keys, toggles, frame time in the title.
+
+use relume::error::{Error, Result};
+use relume::gpu::blit::Blit;
+use relume::gpu::timing::PassTimer;
+use relume::gpu::{BackendChoice, Gpu};
+use relume::player::{Player, Sun};
+use relume::render::camera::Camera;
+use relume::render::mesh_reference::FrameSettings;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+
+struct Orbit {
+    target: glam::Vec3,
+    distance: f32,
+    azimuth: f32,
+    elevation: f32,
+    fov: f32,
+}
+
+impl Orbit {
+    fn from_camera(c: &Camera) -> Orbit {
+        let v = c.eye - c.target;
+        let distance = v.length().max(1e-6);
+        Orbit {
+            target: c.target,
+            distance,
+            azimuth: v.x.atan2(v.z).to_degrees(),
+            elevation: (v.y / distance).clamp(-1.0, 1.0).asin().to_degrees(),
+            fov: c.fov_y_deg,
+        }
+    }
+
+    fn camera(&self) -> Camera {
+        Camera::orbit(
+            self.target,
+            self.distance,
+            self.azimuth,
+            self.elevation,
+            self.fov,
+        )
+    }
+}
+
+struct Running {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    gpu: Gpu,
+    player: Player,
+    blit: Blit,
+    timer: PassTimer,
+    orbit: Orbit,
+    last: Instant,
+    frame_ms: f64,
+}
+
+struct App {
+    dir: PathBuf,
+    size: (u32, u32),
+    sun: Sun,
+    sun_on: bool,
+    camera: Option<Camera>,
+    settings: FrameSettings,
+    backend: Option<BackendChoice>,
+    running: Option<Running>,
+    error: Option<Error>,
+    dragging: Option<(f64, f64)>,
+    cursor: (f64, f64),
+}
+
+/// Open a window on the bake at `dir` and run until it is closed.
+pub fn run(
+    dir: PathBuf,
+    size: (u32, u32),
+    sun: Option<Sun>,
+    camera: Option<Camera>,
+    settings: FrameSettings,
+    backend: Option<BackendChoice>,
+) -> Result<()> {
+    let event_loop = EventLoop::new().map_err(|e| {
+        Error::Gpu(format!(
+            "cannot open a window ({e}); without a display use --headless"
+        ))
+    })?;
+    let mut app = App {
+        dir,
+        size,
+        sun: sun.unwrap_or(Sun {
+            azimuth_deg: 135.0,
+            elevation_deg: 35.0,
+        }),
+        sun_on: sun.is_some(),
+        camera,
+        settings,
+        backend,
+        running: None,
+        error: None,
+        dragging: None,
+        cursor: (0.0, 0.0),
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| Error::Gpu(format!("window event loop failed: {e}")))?;
+    match app.error {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+impl App {
+    fn start(&mut self, el: &ActiveEventLoop) -> Result<Running> {
+        let attrs = Window::default_attributes()
+            .with_title("relume-player")
+            .with_inner_size(winit::dpi::PhysicalSize::new(self.size.0, self.size.1));
+        let window = Arc::new(
+            el.create_window(attrs)
+                .map_err(|e| Error::Gpu(format!("cannot create a window: {e}")))?,
+        );
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        if let Some(b) = self.backend {
+            desc.backends = match b {
+                BackendChoice::Vulkan => wgpu::Backends::VULKAN,
+                BackendChoice::Gl => wgpu::Backends::GL,
+                BackendChoice::Metal => wgpu::Backends::METAL,
+                BackendChoice::Dx12 => wgpu::Backends::DX12,
+            };
+        }
+        let instance = wgpu::Instance::new(desc);
+        let surface = instance
+            .create_surface(window.clone())
+            .map_err(|e| Error::Gpu(format!("cannot create a surface: {e}")))?;
+        let gpu = Gpu::from_instance(&instance, Some(&surface))?;
+        let caps = surface.get_capabilities(&gpu.adapter);
+        // The shaders encode sRGB themselves: prefer a non-sRGB surface format.
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb())
+            .unwrap_or(caps.formats[0]);
+        let size = window.inner_size();
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            present_mode: wgpu::PresentMode::AutoVsync,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: caps.alpha_modes[0],
+            view_formats: vec![],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        surface.configure(&gpu.device, &config);
+        let mut player = Player::load(&gpu, &self.dir, config.width, config.height)?;
+        player.set_sun(&gpu, self.sun_on.then_some(self.sun))?;
+        let orbit = Orbit::from_camera(&self.camera.unwrap_or_else(|| player.default_camera()));
+        let blit = Blit::new(&gpu, format)?;
+        let timer = PassTimer::new(&gpu, 16);
+        Ok(Running {
+            window,
+            surface,
+            config,
+            gpu,
+            player,
+            blit,
+            timer,
+            orbit,
+            last: Instant::now(),
+            frame_ms: 0.0,
+        })
+    }
+
+    fn redraw(&mut self) -> Result<()> {
+        let Some(r) = self.running.as_mut() else {
+            return Ok(());
+        };
+        let t0 = Instant::now();
+        r.player
+            .render(&r.gpu, &r.orbit.camera(), &self.settings, &mut r.timer)?;
+        let frame = match r.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            _ => {
+                r.surface.configure(&r.gpu.device, &r.config);
+                return Ok(());
+            }
+        };
+        let view = frame.texture.create_view(&Default::default());
+        r.blit.draw(&r.gpu, r.player.target_view(), &view);
+        r.gpu.queue.present(frame);
+        r.frame_ms = 0.9 * r.frame_ms + 0.1 * t0.elapsed().as_secs_f64() * 1e3;
+        if r.last.elapsed().as_millis() > 250 {
+            r.last = Instant::now();
+            let s = &self.settings;
+            r.window.set_title(&format!(
+                "relume-player — {:.1} ms/frame — sun {:.0}°/{:.0}°{} — direct {} indirect {} shadows {} emission {}",
+                r.frame_ms,
+                self.sun.azimuth_deg,
+                self.sun.elevation_deg,
+                if self.sun_on { "" } else { " (off)" },
+                on(s.direct),
+                on(s.indirect),
+                on(s.shadows),
+                on(s.emission)
+            ));
+        }
+        r.window.request_redraw();
+        Ok(())
+    }
+
+    fn key(&mut self, key: &Key) -> Result<bool> {
+        let Some(r) = self.running.as_mut() else {
+            return Ok(false);
+        };
+        let mut sun_changed = false;
+        match key {
+            Key::Named(NamedKey::Escape) => return Ok(true),
+            Key::Named(NamedKey::ArrowLeft) => r.orbit.azimuth -= 5.0,
+            Key::Named(NamedKey::ArrowRight) => r.orbit.azimuth += 5.0,
+            Key::Named(NamedKey::ArrowUp) => {
+                r.orbit.elevation = (r.orbit.elevation + 5.0).min(89.0)
+            }
+            Key::Named(NamedKey::ArrowDown) => {
+                r.orbit.elevation = (r.orbit.elevation - 5.0).max(-89.0)
+            }
+            Key::Character(c) => match c.as_str() {
+                "+" | "=" => r.orbit.distance *= 0.9,
+                "-" => r.orbit.distance /= 0.9,
+                "j" | "J" => {
+                    (self.sun.azimuth_deg, sun_changed) = (self.sun.azimuth_deg - 5.0, true)
+                }
+                "l" | "L" => {
+                    (self.sun.azimuth_deg, sun_changed) = (self.sun.azimuth_deg + 5.0, true)
+                }
+                "i" | "I" => {
+                    (self.sun.elevation_deg, sun_changed) =
+                        ((self.sun.elevation_deg + 2.0).min(90.0), true)
+                }
+                "k" | "K" => {
+                    (self.sun.elevation_deg, sun_changed) =
+                        ((self.sun.elevation_deg - 2.0).max(-10.0), true)
+                }
+                "s" | "S" => (self.sun_on, sun_changed) = (!self.sun_on, true),
+                "1" => self.settings.direct = !self.settings.direct,
+                "2" => self.settings.indirect = !self.settings.indirect,
+                "3" => self.settings.shadows = !self.settings.shadows,
+                "4" => self.settings.emission = !self.settings.emission,
+                "[" => self.settings.exposure /= 1.25,
+                "]" => self.settings.exposure *= 1.25,
+                _ => {}
+            },
+            _ => {}
+        }
+        if sun_changed {
+            self.sun_on |=
+                !matches!(key, Key::Character(c) if c.as_str().eq_ignore_ascii_case("s"));
+            r.player.set_sun(&r.gpu, self.sun_on.then_some(self.sun))?;
+        }
+        Ok(false)
+    }
+}
+
+fn on(b: bool) -> &'static str {
+    if b {
+        "on"
+    } else {
+        "off"
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, el: &ActiveEventLoop) {
+        if self.running.is_none() {
+            match self.start(el) {
+                Ok(r) => {
+                    r.window.request_redraw();
+                    self.running = Some(r);
+                }
+                Err(e) => {
+                    self.error = Some(e);
+                    el.exit();
+                }
+            }
+        }
+    }
+
+    fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                el.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(size) => {
+                if let Some(r) = self.running.as_mut() {
+                    r.config.width = size.width.max(1);
+                    r.config.height = size.height.max(1);
+                    r.surface.configure(&r.gpu.device, &r.config);
+                    r.player.resize(&r.gpu, r.config.width, r.config.height)
+                } else {
+                    Ok(())
+                }
+            }
+            WindowEvent::RedrawRequested => self.redraw(),
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                match self.key(&event.logical_key) {
+                    Ok(true) => {
+                        el.exit();
+                        Ok(())
+                    }
+                    Ok(false) => Ok(()),
+                    Err(e) => Err(e),
+                }
+            }
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => {
+                self.dragging = (state == ElementState::Pressed).then_some(self.cursor);
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                self.cursor = (position.x, position.y);
+                if let (Some((x0, y0)), Some(r)) = (self.dragging, self.running.as_mut()) {
+                    r.orbit.azimuth -= (position.x - x0) as f32 * 0.3;
+                    r.orbit.elevation =
+                        (r.orbit.elevation + (position.y - y0) as f32 * 0.3).clamp(-89.0, 89.0);
+                    self.dragging = Some((position.x, position.y));
+                }
+                Ok(())
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                if let Some(r) = self.running.as_mut() {
+                    let d = match delta {
+                        MouseScrollDelta::LineDelta(_, y) => y,
+                        MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                    };
+                    r.orbit.distance *= 0.9f32.powf(d);
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            self.error = Some(e);
+            el.exit();
+        }
+    }
+}

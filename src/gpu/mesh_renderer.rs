@@ -1,0 +1,582 @@
+//! Rasterising a mesh scene: one shadow-map layer per directional/spot light (six per point
+//! light), then `mesh_shade.wgsl` (direct per pixel + indirect per corner + emission, tone map)
+//! into an RGBA8 target. The CPU twin is `relume::render::mesh_reference`.
+
+use super::timing::PassTimer;
+use super::Gpu;
+use crate::error::{Error, Result};
+use crate::render::camera::Camera;
+use crate::render::lights::{shadow_projections, GpuLight, MAX_LIGHTS, MAX_SHADOW_LAYERS};
+use crate::render::mesh_reference::{corner_vertices, FrameSettings};
+use crate::scene::Scene;
+use wgpu::util::DeviceExt;
+
+/// The lights uniform of `lighting.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightsUniform {
+    pub count: u32,
+    pub shadow_bias: f32,
+    pub pad: [u32; 2],
+    pub lights: [GpuLight; MAX_LIGHTS],
+    pub layer_view_proj: [[f32; 16]; MAX_SHADOW_LAYERS],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct FrameUniform {
+    view_proj: [f32; 16],
+    eye: [f32; 4],
+    exposure: f32,
+    emission_scale: f32,
+    flags: u32,
+    pad: u32,
+}
+
+/// Colour format of the render target (tone mapping and sRGB encoding happen in the shader).
+pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// GPU state for drawing one mesh scene.
+pub struct MeshRenderer {
+    shade: wgpu::RenderPipeline,
+    shadow: wgpu::RenderPipeline,
+    vertices: wgpu::Buffer,
+    positions: wgpu::Buffer,
+    /// Per-corner indirect exitance (3 × f32 per corner), written by the gather or by `set_indirect`.
+    pub indirect: wgpu::Buffer,
+    corners: u32,
+    lights: wgpu::Buffer,
+    lights_cpu: LightsUniform,
+    shadow_layers: Vec<wgpu::TextureView>,
+    frame: wgpu::Buffer,
+    group0: wgpu::BindGroup,
+    /// Group 1 (lights + shadow maps), shared with the direct-light kernel.
+    pub group1: wgpu::BindGroup,
+    /// Group 1 for the shadow passes: the lights uniform only (the maps are being written).
+    shadow_group1: wgpu::BindGroup,
+    pub group1_layout: wgpu::BindGroupLayout,
+    target: wgpu::Texture,
+    target_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    bounds: (glam::Vec3, f32),
+    pub width: u32,
+    pub height: u32,
+}
+
+impl MeshRenderer {
+    /// Upload `scene` and create a `width`×`height` target with `shadow_size`² shadow maps.
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        shadow_size: u32,
+    ) -> Result<Self> {
+        let dev = &gpu.device;
+        let max = gpu.info.max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(Error::knob(format!(
+                "image size {width}x{height} is outside 1..={max} (the adapter's limit)"
+            )));
+        }
+        let verts = corner_vertices(scene);
+        let corners = (verts.len() / 12) as u32;
+        let positions: Vec<f32> = verts
+            .chunks_exact(12)
+            .flat_map(|v| [v[0], v[1], v[2]])
+            .collect();
+        let vertices = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("mesh vertices"),
+            contents: bytemuck::cast_slice(&verts),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let positions = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("mesh positions"),
+            contents: bytemuck::cast_slice(&positions),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let indirect = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("indirect per corner"),
+            size: (corners as u64 * 12).max(16),
+            usage: wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let lights_cpu = LightsUniform {
+            count: 0,
+            shadow_bias: 0.0,
+            pad: [0; 2],
+            lights: [GpuLight::default(); MAX_LIGHTS],
+            layer_view_proj: [[0.0; 16]; MAX_SHADOW_LAYERS],
+        };
+        let lights = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lights"),
+            contents: bytemuck::bytes_of(&lights_cpu),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let shadow_tex = dev.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow maps"),
+            size: wgpu::Extent3d {
+                width: shadow_size,
+                height: shadow_size,
+                depth_or_array_layers: MAX_SHADOW_LAYERS as u32,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let shadow_array = shadow_tex.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let shadow_layers = (0..MAX_SHADOW_LAYERS as u32)
+            .map(|l| {
+                shadow_tex.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: l,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let sampler = dev.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow compare"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let group1_layout = lighting_layout(gpu);
+        let group1 = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lighting"),
+            layout: &group1_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: lights.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&shadow_array),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
+        });
+        let frame = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame"),
+            size: std::mem::size_of::<FrameUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group0_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let group0 = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &group0_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: frame.as_entire_binding(),
+            }],
+        });
+        let lights_only_layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lights only"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let shadow_group1 = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lights only"),
+            layout: &lights_only_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: lights.as_entire_binding(),
+            }],
+        });
+        let (shade, shadow) = pipelines(gpu, &group0_layout, &group1_layout, &lights_only_layout)?;
+        let (target, target_view, depth_view) = targets(gpu, width, height);
+        let (lo, hi) = scene.bounds();
+        Ok(MeshRenderer {
+            shade,
+            shadow,
+            vertices,
+            positions,
+            indirect,
+            corners,
+            lights,
+            lights_cpu,
+            shadow_layers,
+            frame,
+            group0,
+            group1,
+            shadow_group1,
+            group1_layout,
+            target,
+            target_view,
+            depth_view,
+            bounds: ((lo + hi) * 0.5, ((hi - lo) * 0.5).length()),
+            width,
+            height,
+        })
+    }
+
+    /// Number of triangle corners (3 per scene triangle).
+    pub fn corners(&self) -> u32 {
+        self.corners
+    }
+
+    /// Set the frame's punctual lights (at most [`MAX_LIGHTS`], at most [`MAX_SHADOW_LAYERS`]
+    /// shadow layers) and compute their shadow projections.
+    pub fn set_lights(&mut self, gpu: &Gpu, lights: &[GpuLight]) -> Result<()> {
+        if lights.len() > MAX_LIGHTS {
+            return Err(Error::knob(format!(
+                "{} lights given, at most {MAX_LIGHTS} are supported",
+                lights.len()
+            )));
+        }
+        let mut layer = 0u32;
+        let mut u = self.lights_cpu;
+        u.count = lights.len() as u32;
+        for (i, l) in lights.iter().enumerate() {
+            let mut l = *l;
+            l.params[1] = layer;
+            for m in shadow_projections(&l, self.bounds.0, self.bounds.1) {
+                if layer as usize >= MAX_SHADOW_LAYERS {
+                    return Err(Error::knob(format!("the lights need more than {MAX_SHADOW_LAYERS} shadow layers (a point light takes 6)")));
+                }
+                u.layer_view_proj[layer as usize] = m.to_cols_array();
+                layer += 1;
+            }
+            u.lights[i] = l;
+        }
+        // Normal offset of about two shadow-map texels of the scene's extent.
+        u.shadow_bias = self.bounds.1 * 2.0 / 1024.0;
+        self.lights_cpu = u;
+        gpu.queue
+            .write_buffer(&self.lights, 0, bytemuck::bytes_of(&u));
+        Ok(())
+    }
+
+    /// The lights uniform as last set.
+    pub fn lights_uniform(&self) -> &LightsUniform {
+        &self.lights_cpu
+    }
+
+    /// Upload per-corner indirect exitance (3 floats per corner).
+    pub fn set_indirect(&self, gpu: &Gpu, per_corner: &[f32]) {
+        gpu.queue
+            .write_buffer(&self.indirect, 0, bytemuck::cast_slice(per_corner));
+    }
+
+    /// Record the shadow passes of the current lights.
+    pub fn record_shadows(&self, enc: &mut wgpu::CommandEncoder, timer: &mut PassTimer) {
+        let layers: u32 = self.lights_cpu.lights[..self.lights_cpu.count as usize]
+            .iter()
+            .map(|l| l.layers())
+            .sum();
+        for layer in 0..layers {
+            let ts = if layer == 0 {
+                timer.render("shadow maps")
+            } else {
+                None
+            };
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.shadow_layers[layer as usize],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: ts,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.shadow);
+            pass.set_bind_group(1, &self.shadow_group1, &[]);
+            pass.set_vertex_buffer(0, self.positions.slice(..));
+            pass.draw(0..self.corners, layer..layer + 1);
+        }
+    }
+
+    /// Record the shading pass for `camera` into the target.
+    pub fn record_shade(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        camera: &Camera,
+        s: &FrameSettings,
+        timer: &mut PassTimer,
+    ) {
+        let f = FrameUniform {
+            view_proj: camera
+                .view_projection(self.width, self.height)
+                .to_cols_array(),
+            eye: camera.eye.extend(1.0).to_array(),
+            exposure: s.exposure,
+            emission_scale: s.emission_scale,
+            flags: s.flags(),
+            pad: 0,
+        };
+        gpu.queue
+            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
+        let bg = s.background;
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shade"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.target_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: bg[0] as f64,
+                        g: bg[1] as f64,
+                        b: bg[2] as f64,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.render("shade"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.shade);
+        pass.set_bind_group(0, &self.group0, &[]);
+        pass.set_bind_group(1, &self.group1, &[]);
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_vertex_buffer(1, self.indirect.slice(..));
+        pass.draw(0..self.corners, 0..1);
+    }
+
+    /// The render target (for presenting in a window).
+    pub fn target_view(&self) -> &wgpu::TextureView {
+        &self.target_view
+    }
+
+    /// Resize the render target.
+    pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
+        let (t, tv, dv) = targets(gpu, width.max(1), height.max(1));
+        self.target = t;
+        self.target_view = tv;
+        self.depth_view = dv;
+        self.width = width.max(1);
+        self.height = height.max(1);
+    }
+
+    /// The rendered image as tightly packed RGBA8 rows.
+    pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
+        let px = super::readback::read_texture_4bpp(gpu, &self.target)?;
+        image::RgbaImage::from_raw(self.width, self.height, px)
+            .ok_or_else(|| Error::Internal("readback size".into()))
+    }
+}
+
+/// The bind-group layout of `lighting.wgsl` (group 1).
+pub fn lighting_layout(gpu: &Gpu) -> wgpu::BindGroupLayout {
+    let all = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    gpu.device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lighting"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: all,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: all,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: all,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+            ],
+        })
+}
+
+fn pipelines(
+    gpu: &Gpu,
+    g0: &wgpu::BindGroupLayout,
+    g1: &wgpu::BindGroupLayout,
+    lights_only: &wgpu::BindGroupLayout,
+) -> Result<(wgpu::RenderPipeline, wgpu::RenderPipeline)> {
+    let dev = &gpu.device;
+    let shade_mod = gpu.shader("mesh_shade.wgsl")?;
+    let shadow_mod = gpu.shader("shadow_depth.wgsl")?;
+    let shade_layout = dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &[Some(g0), Some(g1)],
+        immediate_size: 0,
+    });
+    let shadow_layout = dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &[None, Some(lights_only)],
+        immediate_size: 0,
+    });
+    let f3 = |loc: u32, offset: u64| wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x3,
+        offset,
+        shader_location: loc,
+    };
+    let mesh_attrs = [f3(0, 0), f3(1, 12), f3(2, 24), f3(3, 36)];
+    let indirect_attrs = [f3(4, 0)];
+    let depth = |bias: wgpu::DepthBiasState| wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias,
+    };
+    let shade = dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("mesh shade"),
+        layout: Some(&shade_layout),
+        vertex: wgpu::VertexState {
+            module: &shade_mod,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: 48,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &mesh_attrs,
+                }),
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: 12,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &indirect_attrs,
+                }),
+            ],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(depth(Default::default())),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &shade_mod,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(TARGET_FORMAT.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    let pos_attrs = [f3(0, 0)];
+    let shadow = dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("shadow depth"),
+        layout: Some(&shadow_layout),
+        vertex: wgpu::VertexState {
+            module: &shadow_mod,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &pos_attrs,
+            })],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(depth(wgpu::DepthBiasState {
+            constant: 2,
+            slope_scale: 2.0,
+            clamp: 0.0,
+        })),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    });
+    Ok((shade, shadow))
+}
+
+fn targets(
+    gpu: &Gpu,
+    width: u32,
+    height: u32,
+) -> (wgpu::Texture, wgpu::TextureView, wgpu::TextureView) {
+    let size = wgpu::Extent3d {
+        width,
+        height,
+        depth_or_array_layers: 1,
+    };
+    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("target"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: TARGET_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let depth = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("depth"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let tv = target.create_view(&Default::default());
+    let dv = depth.create_view(&Default::default());
+    (target, tv, dv)
+}

@@ -1,0 +1,114 @@
+//! The runtime: load a baked directory and render frames with wgpu. The binary
+//! (`relume-player`) only parses arguments and runs the window or headless loop around this.
+
+mod mesh;
+
+pub use mesh::MeshPlayer;
+
+use crate::baked::Manifest;
+use crate::error::Result;
+use crate::gpu::timing::PassTimer;
+use crate::gpu::Gpu;
+use crate::render::camera::Camera;
+use crate::render::mesh_reference::FrameSettings;
+use serde::Serialize;
+use std::path::Path;
+
+/// The sun as azimuth (degrees clockwise from north) and elevation (degrees above the horizon).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Sun {
+    pub azimuth_deg: f32,
+    pub elevation_deg: f32,
+}
+
+impl Sun {
+    /// Unit vector toward the sun in a y-up scene whose north is −z:
+    /// (sin az · cos el, sin el, −cos az · cos el).
+    pub fn toward_y_up(&self) -> glam::Vec3 {
+        let (az, el) = (
+            self.azimuth_deg.to_radians(),
+            self.elevation_deg.to_radians(),
+        );
+        glam::Vec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos())
+    }
+}
+
+/// What every loaded bake can do each frame.
+pub enum Player {
+    Mesh(Box<MeshPlayer>),
+}
+
+/// Wall and GPU times of one frame.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FrameTimes {
+    pub frame: u32,
+    /// CPU wall time to record, submit and wait for the frame (ms).
+    pub cpu_ms: f64,
+    /// GPU time per pass from timestamp queries (ms); empty when the adapter has none.
+    pub gpu_ms: Vec<(String, f64)>,
+}
+
+impl Player {
+    /// Load the bake at `dir` for a `width`×`height` target.
+    pub fn load(gpu: &Gpu, dir: &Path, width: u32, height: u32) -> Result<Player> {
+        let manifest = Manifest::read(dir)?;
+        match manifest.pipeline.input.kind() {
+            "scene" => Ok(Player::Mesh(Box::new(MeshPlayer::load(
+                gpu, dir, &manifest, width, height,
+            )?))),
+            other => Err(crate::error::Error::unsupported(
+                dir,
+                format!("the player cannot render {other} bakes yet"),
+            )),
+        }
+    }
+
+    /// A camera that frames the bake.
+    pub fn default_camera(&self) -> Camera {
+        match self {
+            Player::Mesh(m) => m.default_camera(),
+        }
+    }
+
+    /// Set the sun (a directional light for mesh scenes).
+    pub fn set_sun(&mut self, gpu: &Gpu, sun: Option<Sun>) -> Result<()> {
+        match self {
+            Player::Mesh(m) => m.set_sun(gpu, sun),
+        }
+    }
+
+    /// Render one frame into the player's target.
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        camera: &Camera,
+        s: &FrameSettings,
+        timer: &mut PassTimer,
+    ) -> Result<()> {
+        match self {
+            Player::Mesh(m) => m.render(gpu, camera, s, timer),
+        }
+    }
+
+    /// The render target of the last frame.
+    pub fn target_view(&self) -> &wgpu::TextureView {
+        match self {
+            Player::Mesh(m) => m.renderer.target_view(),
+        }
+    }
+
+    /// Resize the render target.
+    pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) -> Result<()> {
+        match self {
+            Player::Mesh(m) => m.renderer.resize(gpu, width, height),
+        }
+        Ok(())
+    }
+
+    /// The last frame as an image.
+    pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
+        match self {
+            Player::Mesh(m) => m.renderer.read_image(gpu),
+        }
+    }
+}

@@ -1,0 +1,103 @@
+//! The CPU reference of the mesh shader (`shaders/mesh_shade.wgsl`): the same per-corner vertex
+//! data, the same Lambertian shading and tone map; visibility of punctual lights by ray casting
+//! where the GPU uses shadow maps (so the two agree except near shadow edges).
+
+use super::lights::{light_irradiance, GpuLight};
+use super::tonemap::tonemap;
+use crate::scene::Scene;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// What to draw and how to display it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameSettings {
+    pub exposure: f32,
+    /// Multiplies emitted radiance (the emitters' intensity knob).
+    pub emission_scale: f32,
+    pub direct: bool,
+    pub indirect: bool,
+    pub shadows: bool,
+    pub emission: bool,
+    /// Display colour behind the scene (sRGB, 0..1).
+    pub background: [f32; 3],
+}
+
+impl Default for FrameSettings {
+    fn default() -> Self {
+        FrameSettings {
+            exposure: 1.0,
+            emission_scale: 1.0,
+            direct: true,
+            indirect: true,
+            shadows: true,
+            emission: true,
+            background: [0.0; 3],
+        }
+    }
+}
+
+impl FrameSettings {
+    /// The `flags` word of the `Frame` uniform.
+    pub fn flags(&self) -> u32 {
+        self.direct as u32
+            | (self.indirect as u32) << 1
+            | (self.shadows as u32) << 2
+            | (self.emission as u32) << 3
+    }
+}
+
+/// Per-corner vertex data (3 per triangle): position, face normal, albedo, emission — 12 floats
+/// each, the layout of the GPU vertex buffer. Degenerate triangles get the normal +y.
+pub fn corner_vertices(scene: &Scene) -> Vec<f32> {
+    let mut out = Vec::with_capacity(scene.triangles.len() * 36);
+    for t in 0..scene.triangles.len() {
+        let [a, b, c] = scene.corners(t);
+        let n = (b - a).cross(c - a).normalize_or(Vec3::Y);
+        let m = &scene.materials[scene.triangle_material[t] as usize];
+        for p in [a, b, c] {
+            out.extend_from_slice(&p.to_array());
+            out.extend_from_slice(&n.to_array());
+            out.extend_from_slice(&m.albedo);
+            out.extend_from_slice(&m.emission);
+        }
+    }
+    out
+}
+
+/// Outgoing radiance at a surface point: twin of `shade_point` in mesh_shade.wgsl.
+/// `visible(light_index, p, to_light, distance)` answers whether the light reaches `p`.
+#[allow(clippy::too_many_arguments)]
+pub fn shade_point(
+    s: &FrameSettings,
+    lights: &[GpuLight],
+    p: Vec3,
+    n: Vec3,
+    albedo: Vec3,
+    emission: Vec3,
+    indirect: Vec3,
+    visible: &dyn Fn(usize, Vec3, Vec3, f32) -> bool,
+) -> Vec3 {
+    let mut radiance = Vec3::ZERO;
+    if s.direct {
+        let mut h = Vec3::ZERO;
+        for (i, l) in lights.iter().enumerate() {
+            let (irr, to_light, dist) = light_irradiance(l, p, n);
+            if irr.max_element() > 0.0 && (!s.shadows || visible(i, p, to_light, dist)) {
+                h += irr;
+            }
+        }
+        radiance += albedo / std::f32::consts::PI * h;
+    }
+    if s.indirect {
+        radiance += indirect / std::f32::consts::PI;
+    }
+    if s.emission {
+        radiance += emission * s.emission_scale;
+    }
+    radiance
+}
+
+/// Display colour (sRGB 0..1) of a radiance: twin of the end of `fs_main`.
+pub fn display(s: &FrameSettings, radiance: Vec3) -> [f32; 3] {
+    tonemap(radiance.to_array(), s.exposure)
+}
