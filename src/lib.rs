@@ -13,6 +13,7 @@ pub mod limits;
 pub mod load;
 pub mod pipeline;
 pub mod progress;
+pub mod radiosity;
 pub mod scene;
 pub mod workspace;
 
