@@ -47,7 +47,6 @@ pub struct StageTiming {
 
 /// Bake `pipeline` into `output`. On any error nothing is written and a previous bake at
 /// `output` is left as it was.
-#[allow(unreachable_code, unused_variables, unused_mut)] // until the first stage lands
 pub fn run_pipeline(
     pipeline: &Pipeline,
     output: &Path,
@@ -76,6 +75,7 @@ pub fn run_pipeline(
     records.push(load_record);
 
     let mut ws = Workspace::new();
+    ws.set_memory_budget(opts.max_memory);
     match input {
         LoadedInput::Scene(scene, _) => ws.set_scene(scene),
         LoadedInput::HeightMap(map, _) => ws.set_heightmap(map),
@@ -175,8 +175,17 @@ fn write_input(txn: &mut BakeTransaction, input: &LoadedInput) -> Result<StageRe
 /// Run one stage alone on an existing bake at `dir`, replacing it atomically. Stages that come
 /// after `stage` in pipeline order are dropped from the bake (their inputs changed), and the
 /// manifest's pipeline is updated so that it still describes how to reproduce the bake.
-#[allow(unreachable_code, unused_variables)] // until the first stage lands
 pub fn run_stage_on(dir: &Path, stage: Stage, progress: &dyn Progress) -> Result<BakeReport> {
+    run_stage_on_with(dir, stage, &BakeOptions::default(), progress)
+}
+
+/// [`run_stage_on`] with options (the memory budget).
+pub fn run_stage_on_with(
+    dir: &Path,
+    stage: Stage,
+    opts: &BakeOptions,
+    progress: &dyn Progress,
+) -> Result<BakeReport> {
     let manifest = Manifest::read(dir)?;
     let kind = stage.kind();
     let mpath = dir.join(baked::MANIFEST);
@@ -226,6 +235,7 @@ pub fn run_stage_on(dir: &Path, stage: Stage, progress: &dyn Progress) -> Result
     }
     let mut records: Vec<StageRecord> = kept.into_iter().cloned().collect();
     let mut ws = Workspace::over_bake(dir, manifest.clone());
+    ws.set_memory_budget(opts.max_memory);
     let t = Instant::now();
     let rec = stage.runner().run(&mut ws, &mut txn, progress)?;
     let timings = vec![timing(&rec, t)];

@@ -15,6 +15,7 @@ pub mod load;
 pub mod pipeline;
 pub mod player;
 pub mod progress;
+pub mod radiosity;
 pub mod render;
 pub mod scene;
 pub mod workspace;

@@ -16,6 +16,7 @@ pub struct Workspace {
     scene: Option<Scene>,
     heightmap: Option<HeightMap>,
     artifacts: HashMap<String, Box<dyn Any + Send + Sync>>,
+    memory_budget: Option<u64>,
 }
 
 impl Workspace {
@@ -35,6 +36,17 @@ impl Workspace {
     /// The existing bake this workspace reads from, if any.
     pub fn source_dir(&self) -> Option<&Path> {
         self.source.as_ref().map(|(d, _)| d.as_path())
+    }
+
+    /// Set the memory budget stages check their allocations against (`--max-memory`).
+    pub fn set_memory_budget(&mut self, bytes: u64) {
+        self.memory_budget = Some(bytes);
+    }
+
+    /// The memory budget in bytes (default: 75 % of physical memory).
+    pub fn memory_budget(&self) -> u64 {
+        self.memory_budget
+            .unwrap_or_else(crate::limits::default_max_memory)
     }
 
     pub fn set_scene(&mut self, scene: Scene) {

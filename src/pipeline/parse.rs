@@ -11,9 +11,6 @@ use std::path::Path;
 /// Stage names that belong to relume's design but are not implemented by this version. A
 /// pipeline naming one is rejected as "not yet supported", never silently ignored.
 pub const PLANNED_STAGES: &[&str] = &[
-    "Voxelize",
-    "FormFactors",
-    "Transport",
     "Reorder",
     "Encode",
     "MinmaxMipmap",

@@ -26,44 +26,72 @@ pub trait StageRun {
 
 /// One stage of a pipeline with its knobs. Each variant's knobs live beside the stage's code.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Stage {}
+pub enum Stage {
+    /// Simplify the scene into voxel patches (`crate::radiosity::patches`).
+    Voxelize(crate::radiosity::stages::VoxelizeKnobs),
+    /// Form factors between patches with BVH visibility (`crate::radiosity::formfactor`).
+    FormFactors(crate::radiosity::stages::FormFactorsKnobs),
+    /// k-bounce or infinite-bounce transport matrix (`crate::radiosity::transport`).
+    Transport(crate::radiosity::stages::TransportKnobs),
+}
 
 /// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
 /// alone on a bake invalidates the stages that come after it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum StageKind {}
+pub enum StageKind {
+    Voxelize,
+    FormFactors,
+    Transport,
+}
 
 impl Stage {
     /// Which stage this is.
     pub fn kind(&self) -> StageKind {
-        match *self {}
+        match self {
+            Stage::Voxelize(_) => StageKind::Voxelize,
+            Stage::FormFactors(_) => StageKind::FormFactors,
+            Stage::Transport(_) => StageKind::Transport,
+        }
     }
 
     /// The stage's implementation.
     pub fn runner(&self) -> &dyn StageRun {
-        match *self {}
+        match self {
+            Stage::Voxelize(k) => k,
+            Stage::FormFactors(k) => k,
+            Stage::Transport(k) => k,
+        }
     }
 }
 
 impl StageKind {
     /// The name used in pipeline files and the manifest.
     pub fn name(self) -> &'static str {
-        match self {}
+        match self {
+            StageKind::Voxelize => "voxelize",
+            StageKind::FormFactors => "form_factors",
+            StageKind::Transport => "transport",
+        }
     }
 
     /// The input kind the stage works on (`"scene"` or `"heightmap"`).
     pub fn input_kind(self) -> &'static str {
-        match self {}
+        match self {
+            StageKind::Voxelize | StageKind::FormFactors | StageKind::Transport => "scene",
+        }
     }
 
     /// Stages that must have run before this one (in this pipeline or an earlier bake).
     pub fn requires(self) -> &'static [StageKind] {
-        match self {}
+        match self {
+            StageKind::Voxelize => &[],
+            StageKind::FormFactors => &[StageKind::Voxelize],
+            StageKind::Transport => &[StageKind::Voxelize, StageKind::FormFactors],
+        }
     }
 }
 
 /// Check that every stage fits the input kind and comes after the stages it needs.
-#[allow(unreachable_code, unused_variables, unused_mut)] // until the first stage lands
 pub(super) fn check_order(path: &Path, pipeline: &Pipeline) -> Result<()> {
     let mut done: Vec<StageKind> = Vec::new();
     for stage in &pipeline.stages {

@@ -1,6 +1,7 @@
 //! `relume-bake`: the offline toolchain. Thin: parse arguments into a validated plan, call the
 //! library, show progress, print errors with their cause chain, exit with a code per cause.
 
+mod radiosity;
 mod ui;
 
 use clap::{Args, Parser, Subcommand};
@@ -81,6 +82,8 @@ enum Command {
         /// Baked directory
         baked_dir: PathBuf,
     },
+    #[command(flatten)]
+    Radiosity(radiosity::Command),
     /// Load a scene (.obj .gltf .glb) or height map (.png .jpg .exr .tif .raw) and summarise it
     Load {
         /// Scene or height-map file
@@ -240,6 +243,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             Ok(exit::OK)
         }
         Command::Inspect { baked_dir } => inspect(baked_dir, json),
+        Command::Radiosity(c) => radiosity::run(c, json, cli.global.quiet, ui),
         Command::Load { file, knobs } => {
             let loaded = load_any(
                 file,

@@ -1,0 +1,71 @@
+//! Hemisphere shooting: from each patch, N rays with origins stratified over the patch's area and
+//! cosine-distributed directions about the local surface normal; `F_ij ≈ hits_j / N`.
+//!
+//! A cosine-distributed direction has density cosθ/π, which is exactly the form-factor kernel of
+//! a differential area, so each hit counts 1/N (Malley's method). Origins, the choice of fan
+//! triangle and the two direction coordinates are each Latin-hypercube stratified. A ray that
+//! hits a back face (the inside of a closed object, the outside of a wall) is absorbed: nobody
+//! receives it, and by reciprocity nothing there could see patch i. Rows of a closed scene sum
+//! to 1 by construction.
+
+use super::{Context, FormFactors};
+use crate::progress::Progress;
+use crate::radiosity::geometry::{cosine_direction, item_rng};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Estimate F with `samples` rays per patch; patch i uses the random stream `(seed, i)`.
+pub fn estimate(ctx: &Context, samples: u32, seed: u64, progress: &dyn Progress) -> FormFactors {
+    let n = ctx.samplers.len();
+    let k = samples as usize;
+    let unassigned = AtomicU64::new(0);
+    let mut values = vec![0f32; n * n];
+    progress.begin("form factors (hemisphere)", n as u64);
+    values.par_chunks_mut(n).enumerate().for_each(|(i, row)| {
+        let counts = shoot(ctx, i, k, seed, &unassigned);
+        for (r, c) in row.iter_mut().zip(counts) {
+            *r = (c as f64 / k as f64) as f32;
+        }
+        progress.advance(1);
+    });
+    progress.finish();
+    FormFactors {
+        n,
+        values,
+        rays: n as u64 * k as u64,
+        unassigned_hits: unassigned.into_inner(),
+    }
+}
+
+/// Hit counts per receiving patch for `k` rays from patch `i`.
+pub fn shoot(ctx: &Context, i: usize, k: usize, seed: u64, unassigned: &AtomicU64) -> Vec<u32> {
+    let n = ctx.samplers.len();
+    let mut counts = vec![0u32; n];
+    let sampler = &ctx.samplers[i];
+    if sampler.is_empty() {
+        return counts;
+    }
+    let mut rng = item_rng(seed, i as u64, u64::MAX);
+    let (sel, u, v) = (rng.strata(k), rng.strata(k), rng.strata(k));
+    let (du, dv) = (rng.strata(k), rng.strata(k));
+    let mut lost = 0;
+    for s in 0..k {
+        let (origin, normal) = sampler.sample(sel[s], u[s], v[s]);
+        let dir = cosine_direction(normal, du[s], dv[s]);
+        let Some(hit) = ctx.vis.closest_hit(origin, dir) else {
+            continue;
+        };
+        if !hit.front {
+            continue;
+        }
+        let p = origin + dir * hit.t as f64;
+        match ctx.locator.locate_hit(p, hit.triangle) {
+            Some(j) => counts[j as usize] += 1,
+            None => lost += 1,
+        }
+    }
+    if lost > 0 {
+        unassigned.fetch_add(lost, Ordering::Relaxed);
+    }
+    counts
+}

@@ -1,0 +1,156 @@
+//! Which patch a point on a surface belongs to: the patch of the point's voxel and its
+//! triangle's dominant axis whose pieces are nearest to the point (searching the 26 neighbouring
+//! voxels when the point sits on a voxel boundary). A point under a coplanar cover (the Cornell
+//! ceiling above the light) lies on the cover's piece, so it finds the cover's patch.
+
+use super::geometry::{self, dominant_axis};
+use super::patches::group_key;
+use super::PatchSet;
+use crate::scene::Scene;
+use glam::DVec3;
+
+/// Distance (grid units) within which a point counts as lying on a patch's piece.
+pub const ON_SURFACE: f64 = 1e-3;
+/// Farthest a hit may lie from every piece and still be assigned (grid units).
+pub const MAX_DISTANCE: f64 = 0.05;
+
+/// Point → patch queries over a [`PatchSet`].
+pub struct PatchLocator {
+    dims: [u32; 3],
+    /// Group key of each patch (non-decreasing: patches are sorted by key).
+    keys: Vec<u64>,
+    /// (first piece, piece count) of each patch.
+    ranges: Vec<(usize, usize)>,
+    /// Vertices and unit normal of each piece.
+    pieces: Vec<(Vec<DVec3>, DVec3)>,
+    /// Dominant axis of each scene triangle.
+    triangle_axis: Vec<u8>,
+}
+
+impl PatchLocator {
+    pub fn new(set: &PatchSet, scene: &Scene) -> Self {
+        let keys = set
+            .patches
+            .iter()
+            .map(|p| group_key(p.voxel, p.axis, set.dims))
+            .collect();
+        let ranges = set
+            .patches
+            .iter()
+            .map(|p| (p.first_piece as usize, p.piece_count as usize))
+            .collect();
+        let pieces = set
+            .pieces
+            .iter()
+            .map(|p| {
+                (
+                    p.vertices.iter().map(|&v| DVec3::from(v)).collect(),
+                    DVec3::from(p.normal),
+                )
+            })
+            .collect();
+        let triangle_axis = (0..scene.triangles.len())
+            .map(|t| {
+                let [a, b, c] = scene.corners(t).map(|v| v.as_dvec3());
+                dominant_axis((b - a).cross(c - a))
+            })
+            .collect();
+        PatchLocator {
+            dims: set.dims,
+            keys,
+            ranges,
+            pieces,
+            triangle_axis,
+        }
+    }
+
+    /// Dominant axis of scene triangle `t`.
+    pub fn triangle_axis(&self, t: u32) -> u8 {
+        self.triangle_axis[t as usize]
+    }
+
+    /// The patches of a voxel (which may lie outside the grid) with the given axis.
+    pub fn candidates(&self, voxel: [i64; 3], axis: u8) -> std::ops::Range<usize> {
+        if (0..3).any(|a| voxel[a] < 0 || voxel[a] >= self.dims[a] as i64) {
+            return 0..0;
+        }
+        let key = group_key(voxel.map(|v| v as u32), axis, self.dims);
+        let lo = self.keys.partition_point(|&k| k < key);
+        let hi = lo + self.keys[lo..].partition_point(|&k| k == key);
+        lo..hi
+    }
+
+    /// Distance from `p` to patch `i`'s pieces and the closest point on them.
+    pub fn distance(&self, p: DVec3, i: usize) -> (f64, DVec3) {
+        let (first, count) = self.ranges[i];
+        let mut best = (f64::INFINITY, p);
+        for (poly, n) in &self.pieces[first..first + count] {
+            let q = geometry::closest_point_on_polygon(p, poly, *n);
+            let d = (q - p).length();
+            if d < best.0 {
+                best = (d, q);
+            }
+        }
+        best
+    }
+
+    /// The unit normal of patch `i`'s piece nearest to `p`.
+    pub fn piece_normal_near(&self, i: usize, p: DVec3) -> DVec3 {
+        let (first, count) = self.ranges[i];
+        self.pieces[first..first + count]
+            .iter()
+            .map(|(poly, n)| (geometry::distance_to_polygon(p, poly, *n), *n))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|b| b.1)
+            .unwrap_or(DVec3::Z)
+    }
+
+    /// The patch of `voxel` with `axis` nearest to `p`: (patch, distance, closest point).
+    pub fn nearest_in_voxel(
+        &self,
+        p: DVec3,
+        voxel: [i64; 3],
+        axis: u8,
+    ) -> Option<(u32, f64, DVec3)> {
+        self.candidates(voxel, axis)
+            .map(|i| {
+                let (d, q) = self.distance(p, i);
+                (i as u32, d, q)
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+    }
+
+    /// The patch a point `p` (grid coordinates) on a surface with dominant `axis` belongs to.
+    pub fn locate(&self, p: DVec3, axis: u8) -> Option<u32> {
+        let v = voxel_of(p, self.dims);
+        if let Some((i, d, _)) = self.nearest_in_voxel(p, v, axis) {
+            if d <= ON_SURFACE {
+                return Some(i);
+            }
+        }
+        let mut best: Option<(u32, f64, DVec3)> = None;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let w = [v[0] + dx, v[1] + dy, v[2] + dz];
+                    if let Some(c) = self.nearest_in_voxel(p, w, axis) {
+                        if best.is_none_or(|b| c.1 < b.1) {
+                            best = Some(c);
+                        }
+                    }
+                }
+            }
+        }
+        best.filter(|b| b.1 <= MAX_DISTANCE).map(|b| b.0)
+    }
+
+    /// The patch of a ray hit on scene triangle `t` at `p`.
+    pub fn locate_hit(&self, p: DVec3, t: u32) -> Option<u32> {
+        self.locate(p, self.triangle_axis(t))
+    }
+}
+
+/// The voxel containing `p` (clamped into the grid).
+pub fn voxel_of(p: DVec3, dims: [u32; 3]) -> [i64; 3] {
+    std::array::from_fn(|a| (p[a].floor() as i64).clamp(0, dims[a] as i64 - 1))
+}

@@ -1,0 +1,400 @@
+//! `transport`: the k-bounce transport matrix of seed 003 §4.1 (DESIGN.md §3), per colour channel
+//!
+//! `S_k = Σ_{h=1..k} M^h`,  `M = diag(ρ) F`,  so that the indirect light of direct exitance E is
+//! `B_indirect = S_k · E` (the seed's `F^{k-reflections}`, with its "colour matrix" `F^C = M`),
+//!
+//! and the limit `S_∞ = M (I − M)^{-1} = (I − M)^{-1} M`, solved by one LU factorisation (f64,
+//! partial pivoting, faer). Finite k uses f32 GEMMs (faer) by Horner's rule
+//! (`S ← M + M·S`, k − 1 products) or binary doubling (`S_2m = S_m + M^m S_m`,
+//! `S_{m+1} = M + M S_m`, about 2 log2 k products); `Power::Auto` takes the one with fewer
+//! products (Horner on ties; the benchmark in benches/transport.rs measures both).
+//! `Bounces::Auto(tol)` adds bounces by Horner until the newest bounce's largest row sum
+//! `‖M^h‖_∞` (the most light it can add per unit of emission) is below `tol`.
+//!
+//! Grey scenes (R = G = B albedo everywhere) compute one channel. Infinite and Auto refuse, with a
+//! clear message, a matrix whose spectral radius is (numerically) 1 or more — a closed scene with
+//! albedo 1 never loses energy — instead of returning huge or NaN entries.
+
+use crate::error::{Error, Result};
+use crate::limits;
+use crate::progress::Progress;
+use faer::linalg::matmul::matmul;
+use faer::linalg::solvers::Solve;
+use faer::{Accum, Mat, Par};
+use serde::{Deserialize, Serialize};
+
+/// How many bounces the transport matrix accumulates.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Bounces {
+    /// Exactly k ≥ 1 bounces.
+    Finite(u32),
+    /// All bounces: `M (I − M)^{-1}`.
+    Infinite,
+    /// Add bounces until one more adds less than this tolerance (`‖M^h‖_∞`).
+    Auto(f64),
+}
+
+/// How `S_k` is evaluated for finite k.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Power {
+    /// Whichever of Horner and doubling needs fewer matrix products.
+    #[default]
+    Auto,
+    /// `S ← M + M·S`, k − 1 products.
+    Horner,
+    /// Binary doubling, about 2·log2(k) products.
+    Doubling,
+}
+
+/// Most bounces `Bounces::Auto` will add before giving up.
+pub const MAX_AUTO_BOUNCES: u32 = 10_000;
+/// Spectral radii at or above `1 − this` are refused for Infinite and Auto.
+const SPECTRAL_MARGIN: f64 = 1e-6;
+
+/// Knobs of [`transport`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TransportParams {
+    pub bounces: Bounces,
+    pub power: Power,
+    /// Memory budget in bytes (`--max-memory`).
+    pub max_memory: u64,
+}
+
+/// The transport matrices of every modelled channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transport {
+    /// 1 for grey scenes, else 3.
+    pub channels: usize,
+    pub n: usize,
+    /// `[channels, n, n]` row-major.
+    pub values: Vec<f32>,
+    /// Bounces accumulated per channel (0 = infinite).
+    pub bounces: Vec<u32>,
+    /// Matrix products (GEMMs) performed, all channels.
+    pub products: u32,
+    /// Collatz–Wielandt bounds on the spectral radius of M per channel (lower, upper); computed
+    /// for Infinite and Auto only.
+    pub spectral_bounds: Vec<(f64, f64)>,
+}
+
+impl Transport {
+    /// `(S · e)_i` for channel `c` (a grey transport serves every channel).
+    pub fn apply(&self, c: usize, e: &[f64]) -> Vec<f64> {
+        let c = c.min(self.channels - 1);
+        let m = &self.values[c * self.n * self.n..(c + 1) * self.n * self.n];
+        (0..self.n)
+            .map(|i| {
+                m[i * self.n..(i + 1) * self.n]
+                    .iter()
+                    .zip(e)
+                    .map(|(&s, &x)| s as f64 * x)
+                    .sum()
+            })
+            .collect()
+    }
+}
+
+/// Estimated peak bytes of [`transport`]: the form factors, the output, and the working
+/// matrices of one channel (Horner: M, S, scratch in f32; doubling/Auto: one more; infinite:
+/// two f64 matrices plus M).
+pub fn memory_estimate(n: usize, channels: usize, bounces: Bounces) -> u64 {
+    let n2 = (n * n) as u64;
+    let working = match bounces {
+        Bounces::Infinite => n2 * (8 + 8 + 4),
+        _ => n2 * 4 * 4,
+    };
+    n2 * 4 + channels as u64 * n2 * 4 + working
+}
+
+/// Compute the transport matrix from `f` (`[n, n]` row-major F) and per-patch albedo.
+pub fn transport(
+    f: &[f32],
+    n: usize,
+    albedo: &[[f32; 3]],
+    params: &TransportParams,
+    progress: &dyn Progress,
+) -> Result<Transport> {
+    if f.len() != n * n || albedo.len() != n {
+        return Err(Error::Internal(format!(
+            "transport: {} form factors and {} albedos for {n} patches",
+            f.len(),
+            albedo.len()
+        )));
+    }
+    match params.bounces {
+        Bounces::Finite(0) => return Err(Error::knob("transport: bounces Finite(k) needs k ≥ 1")),
+        Bounces::Auto(t) if !(t.is_finite() && t > 0.0) => {
+            return Err(Error::knob(format!(
+                "transport: Auto tolerance must be a positive number, got {t}"
+            )))
+        }
+        _ => {}
+    }
+    let grey = albedo.iter().all(|a| a[0] == a[1] && a[1] == a[2]);
+    let channels = if grey { 1 } else { 3 };
+    limits::check_memory(
+        &format!("the transport of {n} patches x {channels} channel(s)"),
+        memory_estimate(n, channels, params.bounces),
+        params.max_memory,
+    )?;
+    let mut out = Transport {
+        channels,
+        n,
+        values: Vec::with_capacity(channels * n * n),
+        bounces: Vec::new(),
+        products: 0,
+        spectral_bounds: Vec::new(),
+    };
+    progress.begin("transport", channels as u64);
+    for c in 0..channels {
+        let rho: Vec<f32> = albedo.iter().map(|a| a[c]).collect();
+        let m = Mat::<f32>::from_fn(n, n, |i, j| rho[i] * f[i * n + j]);
+        let (s, k, products) = match params.bounces {
+            Bounces::Finite(k) => {
+                let (s, p) = power_sum(&m, k, params.power);
+                (s, k, p)
+            }
+            Bounces::Auto(tol) => {
+                let bounds = spectral_bounds(&m);
+                out.spectral_bounds.push(bounds);
+                refuse_divergent(bounds, "Auto")?;
+                auto_sum(&m, tol)?
+            }
+            Bounces::Infinite => {
+                let bounds = spectral_bounds(&m);
+                out.spectral_bounds.push(bounds);
+                refuse_divergent(bounds, "Infinite")?;
+                (infinite(&m)?, 0, 0)
+            }
+        };
+        out.bounces.push(k);
+        out.products += products;
+        for i in 0..n {
+            out.values.extend((0..n).map(|j| s[(i, j)]));
+        }
+        progress.advance(1);
+    }
+    progress.finish();
+    Ok(out)
+}
+
+fn refuse_divergent(bounds: (f64, f64), what: &str) -> Result<()> {
+    if bounds.0 >= 1.0 - SPECTRAL_MARGIN {
+        return Err(Error::knob(format!(
+            "transport: bounces {what} diverges here: the spectral radius of diag(albedo)·F is at least {:.7} \
+             (light never dies out — a closed scene with albedo 1 reflects everything forever). \
+             Use `bounces: Finite(k)`, or lower the albedo below 1",
+            bounds.0
+        )));
+    }
+    Ok(())
+}
+
+fn par() -> Par {
+    Par::rayon(0)
+}
+
+/// `dst = a · b` (Accum::Replace) or `dst += a · b` (Accum::Add).
+fn gemm(dst: &mut Mat<f32>, accum: Accum, a: &Mat<f32>, b: &Mat<f32>) {
+    matmul(dst.as_mut(), accum, a.as_ref(), b.as_ref(), 1.0f32, par());
+}
+
+/// Number of products Horner and doubling need for `k` bounces.
+pub fn products(k: u32) -> (u32, u32) {
+    let horner = k.saturating_sub(1);
+    let bits = 32 - k.leading_zeros();
+    let mut doubling = 0;
+    for b in (0..bits.saturating_sub(1)).rev() {
+        let more = b > 0;
+        let set = (k >> b) & 1 == 1;
+        doubling += 1 + u32::from(more || set); // S ← S + P S; P ← P P when still needed
+        if set {
+            doubling += 1 + u32::from(more); // S ← M + M S; P ← M P when still needed
+        }
+    }
+    (horner, doubling)
+}
+
+/// `Σ_{h=1..k} M^h` and the number of products used.
+pub fn power_sum(m: &Mat<f32>, k: u32, power: Power) -> (Mat<f32>, u32) {
+    let (h, d) = products(k);
+    let use_doubling = match power {
+        Power::Auto => d < h,
+        Power::Horner => false,
+        Power::Doubling => true,
+    };
+    if use_doubling {
+        (doubling(m, k), d)
+    } else {
+        (horner(m, k), h)
+    }
+}
+
+fn horner(m: &Mat<f32>, k: u32) -> Mat<f32> {
+    let mut s = m.clone();
+    let mut next = m.clone();
+    for _ in 1..k {
+        next.copy_from(m);
+        gemm(&mut next, Accum::Add, m, &s);
+        std::mem::swap(&mut s, &mut next);
+    }
+    s
+}
+
+fn doubling(m: &Mat<f32>, k: u32) -> Mat<f32> {
+    let bits = 32 - k.leading_zeros();
+    let mut s = m.clone();
+    let mut p = m.clone(); // P = M^j for the current j
+    let mut tmp = Mat::<f32>::zeros(m.nrows(), m.ncols());
+    for b in (0..bits.saturating_sub(1)).rev() {
+        let more = b > 0;
+        let set = (k >> b) & 1 == 1;
+        tmp.copy_from(&s);
+        gemm(&mut tmp, Accum::Add, &p, &s); // S_2j = S_j + M^j S_j
+        std::mem::swap(&mut s, &mut tmp);
+        if more || set {
+            gemm(&mut tmp, Accum::Replace, &p, &p); // M^2j
+            std::mem::swap(&mut p, &mut tmp);
+        }
+        if set {
+            tmp.copy_from(m);
+            gemm(&mut tmp, Accum::Add, m, &s); // S_{2j+1} = M + M S_2j
+            std::mem::swap(&mut s, &mut tmp);
+            if more {
+                gemm(&mut tmp, Accum::Replace, m, &p); // M^{2j+1}
+                std::mem::swap(&mut p, &mut tmp);
+            }
+        }
+    }
+    s
+}
+
+/// Largest row sum (∞-norm) of a non-negative matrix.
+fn max_row_sum(a: &Mat<f32>) -> f64 {
+    let mut sums = vec![0f64; a.nrows()];
+    for j in 0..a.ncols() {
+        for (i, s) in sums.iter_mut().enumerate() {
+            *s += a[(i, j)].abs() as f64;
+        }
+    }
+    sums.into_iter().fold(0.0, f64::max)
+}
+
+fn auto_sum(m: &Mat<f32>, tol: f64) -> Result<(Mat<f32>, u32, u32)> {
+    let mut s = m.clone();
+    let mut term = m.clone();
+    let mut next = Mat::<f32>::zeros(m.nrows(), m.ncols());
+    let mut k = 1;
+    let mut products = 0;
+    while max_row_sum(&term) >= tol {
+        if k >= MAX_AUTO_BOUNCES {
+            return Err(Error::knob(format!(
+                "transport: Auto({tol}) still adds more than the tolerance after {MAX_AUTO_BOUNCES} bounces; use a larger tolerance or Infinite"
+            )));
+        }
+        gemm(&mut next, Accum::Replace, m, &term);
+        std::mem::swap(&mut term, &mut next);
+        s += &term;
+        k += 1;
+        products += 1;
+    }
+    Ok((s, k, products))
+}
+
+/// `(I − M)^{-1} M` by LU with partial pivoting in f64.
+fn infinite(m: &Mat<f32>) -> Result<Mat<f32>> {
+    let n = m.nrows();
+    let a = Mat::<f64>::from_fn(n, n, |i, j| f64::from(i == j) - m[(i, j)] as f64);
+    let lu = a.partial_piv_lu();
+    drop(a);
+    let u = lu.U();
+    let (mut lo, mut hi) = (f64::INFINITY, 0f64);
+    for i in 0..n {
+        let d = u[(i, i)].abs();
+        lo = lo.min(d);
+        hi = hi.max(d);
+    }
+    if !(lo.is_finite() && hi.is_finite()) || lo <= 1e-12 * hi.max(1.0) {
+        return Err(Error::knob(format!(
+            "transport: I − diag(albedo)·F is singular (smallest LU pivot {lo:e}): infinite bounces diverge; use `bounces: Finite(k)`"
+        )));
+    }
+    let mut x = Mat::<f64>::from_fn(n, n, |i, j| m[(i, j)] as f64);
+    lu.solve_in_place(x.as_mut());
+    let mut s = Mat::<f32>::zeros(n, n);
+    for j in 0..n {
+        for i in 0..n {
+            let v = x[(i, j)];
+            if !v.is_finite() {
+                return Err(Error::knob(
+                    "transport: the infinite-bounce solve produced a non-finite value; use `bounces: Finite(k)`",
+                ));
+            }
+            // S is non-negative in exact arithmetic; clamp rounding noise around zeros.
+            s[(i, j)] = v.max(0.0) as f32;
+        }
+    }
+    Ok(s)
+}
+
+/// Collatz–Wielandt bounds (lower, upper) on the spectral radius of a non-negative matrix, from
+/// 64 steps of power iteration started at the all-ones vector.
+pub fn spectral_bounds(m: &Mat<f32>) -> (f64, f64) {
+    let n = m.nrows();
+    let mut x = vec![1f64; n];
+    let mut bounds: (f64, f64) = (0.0, f64::INFINITY);
+    for _ in 0..64 {
+        let mut y = vec![0f64; n];
+        for j in 0..n {
+            let xj = x[j];
+            if xj != 0.0 {
+                for (i, yi) in y.iter_mut().enumerate() {
+                    *yi += m[(i, j)] as f64 * xj;
+                }
+            }
+        }
+        let (mut lo, mut hi) = (f64::INFINITY, 0f64);
+        for i in 0..n {
+            if x[i] > 0.0 {
+                let r = y[i] / x[i];
+                lo = lo.min(r);
+                hi = hi.max(r);
+            }
+        }
+        if lo.is_finite() {
+            bounds = (bounds.0.max(lo), bounds.1.min(hi));
+        }
+        let top = y.iter().copied().fold(0.0, f64::max);
+        if top <= 0.0 {
+            return (0.0, 0.0);
+        }
+        x = y.into_iter().map(|v| v / top).collect();
+    }
+    bounds
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn product_counts() {
+        assert_eq!(products(1), (0, 0));
+        assert_eq!(products(2), (1, 1));
+        assert_eq!(products(8), (7, 5));
+        assert_eq!(products(3), (2, 3));
+    }
+
+    #[test]
+    fn horner_and_doubling_agree() {
+        let m = Mat::<f32>::from_fn(5, 5, |i, j| 0.04 * ((i * 7 + j * 3) % 5) as f32);
+        for k in 1..12 {
+            let (a, b) = (horner(&m, k), doubling(&m, k));
+            for i in 0..5 {
+                for j in 0..5 {
+                    assert!((a[(i, j)] - b[(i, j)]).abs() < 1e-6, "k={k}");
+                }
+            }
+        }
+    }
+}
