@@ -101,7 +101,8 @@ impl MeshRenderer {
             size: (corners as u64 * 12).max(16),
             usage: wgpu::BufferUsages::VERTEX
                 | wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST,
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         let lights_cpu = LightsUniform {

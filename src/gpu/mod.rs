@@ -8,6 +8,7 @@
 pub mod blit;
 pub mod compute;
 pub mod mesh_renderer;
+pub mod radiosity_runtime;
 pub mod readback;
 pub mod timing;
 
@@ -159,6 +160,18 @@ impl Gpu {
 pub const SHADERS: &[(&str, &str)] = &[
     ("blit.wgsl", include_str!("../../shaders/blit.wgsl")),
     ("common.wgsl", include_str!("../../shaders/common.wgsl")),
+    (
+        "corner_transfer.wgsl",
+        include_str!("../../shaders/corner_transfer.wgsl"),
+    ),
+    (
+        "direct_light.wgsl",
+        include_str!("../../shaders/direct_light.wgsl"),
+    ),
+    (
+        "gather_dense.wgsl",
+        include_str!("../../shaders/gather_dense.wgsl"),
+    ),
     ("lighting.wgsl", include_str!("../../shaders/lighting.wgsl")),
     (
         "mesh_shade.wgsl",

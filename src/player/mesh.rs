@@ -5,8 +5,10 @@ use super::Sun;
 use crate::baked::{read_scene, Manifest};
 use crate::error::Result;
 use crate::gpu::mesh_renderer::MeshRenderer;
+use crate::gpu::radiosity_runtime::{DenseTransport, RadiosityRuntime};
 use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
+use crate::radiosity::{PatchSet, PATCHES_FILE, TRANSPORT_FILE};
 use crate::render::camera::Camera;
 use crate::render::lights::GpuLight;
 use crate::render::mesh_reference::FrameSettings;
@@ -21,6 +23,8 @@ pub struct MeshPlayer {
     pub scene_lights: Vec<GpuLight>,
     /// The sun, when set.
     pub sun: Option<GpuLight>,
+    /// The baked light transfer, when the bake has one.
+    pub radiosity: Option<(PatchSet, RadiosityRuntime)>,
 }
 
 /// Shadow-map resolution.
@@ -31,7 +35,7 @@ impl MeshPlayer {
     pub fn load(
         gpu: &Gpu,
         dir: &Path,
-        _manifest: &Manifest,
+        manifest: &Manifest,
         width: u32,
         height: u32,
     ) -> Result<Self> {
@@ -42,11 +46,38 @@ impl MeshPlayer {
             .iter()
             .map(|l| GpuLight::from_light(l, 1.0, 0))
             .collect();
+        let radiosity = if manifest.file(TRANSPORT_FILE).is_some() {
+            let set: PatchSet = crate::baked::read_postcard(&dir.join(PATCHES_FILE))?;
+            let (shape, data) = crate::baked::read_npy_f32(&dir.join(TRANSPORT_FILE))?;
+            let (channels, n) = match shape.as_slice() {
+                [c, n, m] if n == m => (*c as usize, *n as usize),
+                _ => {
+                    return Err(crate::error::Error::input(
+                        dir.join(TRANSPORT_FILE),
+                        format!("shape {shape:?} is not [channels, n, n]"),
+                    ))
+                }
+            };
+            let rt = RadiosityRuntime::new(
+                gpu,
+                &set,
+                DenseTransport {
+                    channels,
+                    n,
+                    data: &data,
+                },
+                &renderer,
+            )?;
+            Some((set, rt))
+        } else {
+            None
+        };
         let mut p = MeshPlayer {
             scene,
             renderer,
             scene_lights,
             sun: None,
+            radiosity,
         };
         p.upload_lights(gpu)?;
         Ok(p)
@@ -95,6 +126,16 @@ impl MeshPlayer {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         if s.direct && s.shadows {
             self.renderer.record_shadows(&mut enc, timer);
+        }
+        if let Some((set, rt)) = &self.radiosity {
+            rt.record(
+                gpu,
+                &mut enc,
+                &self.renderer,
+                s,
+                set.samples_per_patch,
+                timer,
+            );
         }
         self.renderer.record_shade(gpu, &mut enc, camera, s, timer);
         timer.resolve(&mut enc);

@@ -46,15 +46,27 @@ impl FrameSettings {
     }
 }
 
+/// How far emitters are lifted off their plane, relative to the scene's diagonal, so that an
+/// emitter lying in a wall (the Cornell box light in its ceiling) is what the eye sees.
+pub const EMITTER_LIFT: f32 = 1e-4;
+
 /// Per-corner vertex data (3 per triangle): position, face normal, albedo, emission — 12 floats
-/// each, the layout of the GPU vertex buffer. Degenerate triangles get the normal +y.
+/// each, the layout of the GPU vertex buffer. Degenerate triangles get the normal +y; emissive
+/// triangles are lifted by [`EMITTER_LIFT`] × the scene diagonal along their normal.
 pub fn corner_vertices(scene: &Scene) -> Vec<f32> {
+    let (lo, hi) = scene.bounds();
+    let lift = EMITTER_LIFT * (hi - lo).length();
     let mut out = Vec::with_capacity(scene.triangles.len() * 36);
     for t in 0..scene.triangles.len() {
         let [a, b, c] = scene.corners(t);
         let n = (b - a).cross(c - a).normalize_or(Vec3::Y);
         let m = &scene.materials[scene.triangle_material[t] as usize];
-        for p in [a, b, c] {
+        let offset = if m.is_emissive() {
+            n * lift
+        } else {
+            Vec3::ZERO
+        };
+        for p in [a + offset, b + offset, c + offset] {
             out.extend_from_slice(&p.to_array());
             out.extend_from_slice(&n.to_array());
             out.extend_from_slice(&m.albedo);

@@ -1,6 +1,8 @@
 //! CPU reference renderer and the pieces shared with the GPU player (camera, tone mapping).
 
 pub mod camera;
+pub mod direct;
 pub mod lights;
 pub mod mesh_reference;
+pub mod raycast;
 pub mod tonemap;

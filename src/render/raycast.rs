@@ -1,0 +1,132 @@
+//! The CPU reference image of a mesh frame: one primary ray per pixel centre through the same
+//! camera, the same per-corner vertex data and indirect light as the GPU, `shade_point` and the
+//! tone map; punctual-light visibility by shadow rays through the BVH (the GPU uses shadow maps,
+//! so the two images differ only near shadow edges).
+
+use super::camera::Camera;
+use super::lights::{GpuLight, KIND_DIRECTIONAL};
+use super::mesh_reference::{corner_vertices, display, shade_point, FrameSettings};
+use super::tonemap::to_u8;
+use crate::radiosity::geometry::Frame;
+use crate::radiosity::visibility::Visibility;
+use crate::scene::{Material, Scene};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+/// A scene prepared for reference ray casting.
+pub struct RaycastScene {
+    verts: Vec<f32>,
+    vis: Visibility,
+    extent: f32,
+}
+
+impl RaycastScene {
+    /// Build the BVH over the same (lifted) corner positions the GPU draws.
+    pub fn new(scene: &Scene) -> Self {
+        let verts = corner_vertices(scene);
+        let corners = verts.len() / 12;
+        let flat = Scene {
+            positions: (0..corners)
+                .map(|k| [verts[12 * k], verts[12 * k + 1], verts[12 * k + 2]])
+                .collect(),
+            triangles: (0..corners as u32 / 3)
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect(),
+            triangle_material: vec![0; corners / 3],
+            triangle_object: vec![0; corners / 3],
+            objects: vec!["all".into()],
+            materials: vec![Material::default_grey()],
+            lights: Vec::new(),
+        };
+        let live = crate::radiosity::patches::live_triangles(&flat);
+        let (lo, hi) = flat.bounds();
+        let extent = lo.abs().max(hi.abs()).max_element().max(1e-6);
+        let vis = Visibility::new(
+            &flat,
+            &live,
+            &Frame {
+                origin: DVec3::ZERO,
+                scale: 1.0,
+            },
+            extent as f64,
+        );
+        RaycastScene { verts, vis, extent }
+    }
+
+    /// Render `width`×`height` RGBA8 with per-corner indirect exitance `indirect` (3 floats per
+    /// corner, or empty for none).
+    pub fn render(
+        &self,
+        camera: &Camera,
+        lights: &[GpuLight],
+        s: &FrameSettings,
+        indirect: &[f32],
+        width: u32,
+        height: u32,
+    ) -> image::RgbaImage {
+        let bg = s.background.map(to_u8);
+        let far = 4.0 * self.extent;
+        let visible = |l: usize, p: Vec3, to_light: Vec3, dist: f32| {
+            let light = &lights[l];
+            let end = if light.kind() == KIND_DIRECTIONAL {
+                p + to_light * far
+            } else {
+                p + to_light * dist
+            };
+            !self.vis.occluded(p.as_dvec3(), end.as_dvec3())
+        };
+        let rows: Vec<Vec<u8>> = (0..height)
+            .into_par_iter()
+            .map(|y| {
+                let mut row = Vec::with_capacity(width as usize * 4);
+                for x in 0..width {
+                    let (o, d) = camera.ray(x, y, width, height);
+                    let px = match self.vis.closest_hit(o.as_dvec3(), d.as_dvec3()) {
+                        None => [bg[0], bg[1], bg[2], 255],
+                        Some(hit) => {
+                            let t = hit.triangle as usize;
+                            let v = |k: usize, f: usize| {
+                                Vec3::from_slice(&self.verts[12 * (3 * t + k) + f..][..3])
+                            };
+                            let p = o + d * hit.t;
+                            let (a, b, c) = (v(0, 0), v(1, 0), v(2, 0));
+                            let w = barycentric(p, a, b, c);
+                            let mut n = v(0, 3);
+                            if n.dot(d) > 0.0 {
+                                n = -n;
+                            }
+                            let ind = if indirect.is_empty() {
+                                Vec3::ZERO
+                            } else {
+                                (0..3)
+                                    .map(|k| {
+                                        w[k] * Vec3::from_slice(&indirect[3 * (3 * t + k)..][..3])
+                                    })
+                                    .sum()
+                            };
+                            let rad = shade_point(s, lights, p, n, v(0, 6), v(0, 9), ind, &visible);
+                            let c = display(s, rad);
+                            [to_u8(c[0]), to_u8(c[1]), to_u8(c[2]), 255]
+                        }
+                    };
+                    row.extend_from_slice(&px);
+                }
+                row
+            })
+            .collect();
+        image::RgbaImage::from_raw(width, height, rows.concat()).expect("size matches")
+    }
+}
+
+/// Barycentric weights of `p` in triangle (a, b, c).
+fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+    let (v0, v1, v2) = (b - a, c - a, p - a);
+    let (d00, d01, d11, d20, d21) = (v0.dot(v0), v0.dot(v1), v1.dot(v1), v2.dot(v0), v2.dot(v1));
+    let den = d00 * d11 - d01 * d01;
+    if den.abs() < f32::MIN_POSITIVE {
+        return [1.0, 0.0, 0.0];
+    }
+    let v = (d11 * d20 - d01 * d21) / den;
+    let w = (d00 * d21 - d01 * d20) / den;
+    [1.0 - v - w, v, w]
+}
