@@ -25,8 +25,14 @@ demo: build
 	$(BAKE) run pipelines/puget-sound.ron --out out/demo/puget-sound
 	$(BAKE) inspect out/demo/cornell
 	$(BAKE) inspect out/demo/puget-sound
+	@mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
+	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --out out/demo/cornell-frames
+	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --sun 135,25 --frames 4 --out out/demo/cornell-sun-frames
 	@echo
-	@echo "demo output is in out/demo/"
+	@echo "demo output is in out/demo/:"
+	@echo "  out/demo/cornell/, out/demo/puget-sound/           baked directories (relume-bake inspect DIR)"
+	@echo "  out/demo/cornell-frames/frame_0000.png             the Cornell box lit by its ceiling light"
+	@echo "  out/demo/cornell-sun-frames/frame_000[0-3].png     plus a sun turning around it"
 
 ## Install what the tests need (software Vulkan, Python cross-check readers), then run them all.
 test: deps

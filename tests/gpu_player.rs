@@ -74,7 +74,7 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     let mut player = Player::load(&gpu, &dir, w, h).unwrap();
     let camera = player.default_camera();
     let s = FrameSettings::default();
-    let mut timer = relume::gpu::timing::PassTimer::new(&gpu, 16);
+    let mut timer = relume::gpu::timing::PassTimer::new(&gpu, 48);
     player.render(&gpu, &camera, &s, &mut timer).unwrap();
     let gpu_img = player.read_image(&gpu).unwrap();
 
@@ -183,7 +183,7 @@ fn punctual_lights_with_shadow_maps_match_ray_traced_shadows() {
         exposure: 0.6,
         ..Default::default()
     };
-    let mut timer = relume::gpu::timing::PassTimer::new(&gpu, 16);
+    let mut timer = relume::gpu::timing::PassTimer::new(&gpu, 48);
     player.render(&gpu, &camera, &s, &mut timer).unwrap();
     let gpu_img = player.read_image(&gpu).unwrap();
     let Player::Mesh(m) = &player;

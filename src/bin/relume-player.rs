@@ -199,7 +199,7 @@ fn run(cli: &Cli) -> Result<()> {
     let s = settings(cli);
     std::fs::create_dir_all(&cli.out)
         .map_err(|e| Error::io(&cli.out, "cannot create output directory", e))?;
-    let mut timer = PassTimer::new(&gpu, 16);
+    let mut timer = PassTimer::new(&gpu, 48);
     let mut frames = Vec::new();
     for f in 0..cli.frames {
         let sun = cli.sun.map(|s| Sun {

@@ -301,11 +301,7 @@ impl MeshRenderer {
             .map(|l| l.layers())
             .sum();
         for layer in 0..layers {
-            let ts = if layer == 0 {
-                timer.render("shadow maps")
-            } else {
-                None
-            };
+            let ts = timer.render("shadow maps");
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
                 color_attachments: &[],

@@ -84,7 +84,8 @@ impl PassTimer {
         }
     }
 
-    /// Milliseconds per pass of the last submitted frame (empty when unavailable).
+    /// Milliseconds per pass name of the last submitted frame, summed over passes that share a
+    /// name, in order of first appearance (empty when unavailable).
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<(&'static str, f64)>> {
         let Some(buf) = &self.resolve else {
             return Ok(Vec::new());

@@ -162,7 +162,7 @@ impl App {
         player.set_sun(&gpu, self.sun_on.then_some(self.sun))?;
         let orbit = Orbit::from_camera(&self.camera.unwrap_or_else(|| player.default_camera()));
         let blit = Blit::new(&gpu, format)?;
-        let timer = PassTimer::new(&gpu, 16);
+        let timer = PassTimer::new(&gpu, 48);
         Ok(Running {
             window,
             surface,
