@@ -19,12 +19,14 @@
 
 pub mod bc1;
 pub mod blocks;
+pub mod containers;
 pub mod dense;
 pub mod gather;
 pub mod logmap;
 pub mod reorder;
 pub mod report;
 pub mod split;
+pub mod stages;
 
 use crate::error::{Error, Result};
 use std::path::Path;

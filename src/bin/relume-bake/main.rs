@@ -1,6 +1,7 @@
 //! `relume-bake`: the offline toolchain. Thin: parse arguments into a validated plan, call the
 //! library, show progress, print errors with their cause chain, exit with a code per cause.
 
+mod compress;
 mod ui;
 
 use clap::{Args, Parser, Subcommand};
@@ -88,6 +89,8 @@ enum Command {
         #[command(flatten)]
         knobs: LoadKnobs,
     },
+    #[command(flatten)]
+    Compress(compress::CompressCommand),
 }
 
 #[derive(Args, Clone)]
@@ -240,6 +243,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             Ok(exit::OK)
         }
         Command::Inspect { baked_dir } => inspect(baked_dir, json),
+        Command::Compress(c) => compress::run(c, ui, json, cli.global.quiet),
         Command::Load { file, knobs } => {
             let loaded = load_any(
                 file,
