@@ -181,6 +181,10 @@ fn dds_and_ktx2_round_trip_every_encoding() {
                     container,
                     "--max-texture-size",
                     "64",
+                    "--split-percent",
+                    "4",
+                    "--fill-holes",
+                    "false",
                 ],
             );
             let back = read_encoded(&dir).unwrap();
@@ -293,4 +297,41 @@ fn bad_encode_knobs_and_missing_transport_are_errors() {
     );
     let err = expect_code(&o, 3);
     assert!(err.contains("transport.npy"), "{}", text(&o));
+}
+
+#[test]
+fn default_encode_meets_the_goal_on_the_box() {
+    // Issue 4's goal: ≤ 2 % RMS relative error of the gathered light at ≤ 1.5x the bytes of the
+    // seed's scheme (Bc1Log, p = 4 %), here on the small box and the standard lights.
+    let tmp = tempfile::tempdir().unwrap();
+    let s = transport_box::transport(&transport_box::closed_box(8, 2), None); // n = 384
+    let dir = bake_with_transport(tmp.path(), "b", &s);
+    let d = dir.to_str().unwrap();
+    run_ok(tmp.path(), &["-q", "reorder", d]);
+    run_ok(tmp.path(), &["-q", "encode", d]);
+    let m = Manifest::read(&dir).unwrap();
+    let rec = m.stage("encode").unwrap();
+    assert_eq!(rec.facts["encoding"], "bc6h");
+    let enc = read_encoded(&dir).unwrap();
+    let seed = compress(
+        &s.permuted(&enc.perm),
+        enc.perm.clone(),
+        4.0,
+        &EncodeOptions::default(),
+    )
+    .unwrap();
+    assert!(
+        enc.bytes() as f64 <= 1.5 * seed.bytes() as f64,
+        "{} vs seed {}",
+        enc.bytes(),
+        seed.bytes()
+    );
+    for light in ["uniform", "random", "half"] {
+        let v = rec.report[&format!("gather_rms_rel_{light}")];
+        assert!(v <= 0.02, "{light}: {v}");
+    }
+    for (name, e) in transport_box::box_lights(&transport_box::closed_box(8, 2)) {
+        let r = report::rms_relative(&gather(&enc, &e), &s.mat_vec(&e));
+        assert!(r <= 0.02, "{name}: {r}");
+    }
 }

@@ -97,6 +97,8 @@ pub struct EncodeOptions {
     pub fill_holes: bool,
 }
 
+/// The seed's scheme (Bc1Log, range 25, no feedback, zeroed holes). The `encode` stage's
+/// defaults differ (see `stages::EncodeKnobs`).
 impl Default for EncodeOptions {
     fn default() -> Self {
         EncodeOptions {

@@ -21,7 +21,7 @@ pub enum CompressCommand {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(0..=2))]
         passes: u8,
         /// What the passes compare
-        #[arg(long, value_enum, default_value_t = MetricArg::Log)]
+        #[arg(long, value_enum, default_value_t = MetricArg::Linear)]
         metric: MetricArg,
     },
     /// Split, map and block-compress a bake's transport (uses permutation.bin when present)
