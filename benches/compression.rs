@@ -5,6 +5,7 @@
 //! `RELUME_BENCH_BOUNCES` (`inf` or a count, default `inf`), `RELUME_TRANSPORT_NPY` (use a
 //! real bake's `transport.npy` instead; the box lights are then replaced by the standard ones).
 //! Times are medians of 5 runs, reported as ratios to a dense f32 mat-vec in the same run.
+#![allow(clippy::needless_range_loop)]
 
 #[path = "../tests/support/transport_box.rs"]
 mod transport_box;

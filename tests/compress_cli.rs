@@ -1,5 +1,6 @@
 //! `relume-bake reorder|encode|gather` on a baked directory; DDS/KTX2 round trips; Pillow
 //! cross-check of the BC1 texture; tiling; determinism.
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 #[path = "support/transport_box.rs"]

@@ -1,4 +1,5 @@
 //! Compression library: exactness, extremes, laws (issue 4 "Tests").
+#![allow(clippy::needless_range_loop)]
 
 #[path = "support/transport_box.rs"]
 mod transport_box;

@@ -17,6 +17,9 @@
 //! (x = column j, y = row i) of the dense texture holds entry (i, j) of S' with its colour
 //! channels as R, G, B.
 
+// Block and texel index arithmetic is written as in the format specs (and the WGSL port).
+#![allow(clippy::needless_range_loop)]
+
 pub mod bc1;
 pub mod blocks;
 pub mod containers;
