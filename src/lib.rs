@@ -7,6 +7,7 @@
 
 pub mod bake;
 pub mod baked;
+pub mod compress;
 pub mod error;
 pub mod gpu;
 pub mod heightmap;

@@ -76,6 +76,15 @@ impl Workspace {
         Ok(self.heightmap.as_ref().unwrap())
     }
 
+    /// Is there an artifact under `file`, made earlier in this run or in the source bake?
+    pub fn has(&self, file: &str) -> bool {
+        self.artifacts.contains_key(file)
+            || self
+                .source
+                .as_ref()
+                .is_some_and(|(_, m)| m.file(file).is_some())
+    }
+
     /// Store an artifact under the file name it is written to.
     pub fn put<T: Any + Send + Sync>(&mut self, file: &str, value: T) {
         self.artifacts.insert(file.to_string(), Box::new(value));

@@ -11,8 +11,6 @@ use std::path::Path;
 /// Stage names that belong to relume's design but are not implemented by this version. A
 /// pipeline naming one is rejected as "not yet supported", never silently ignored.
 pub const PLANNED_STAGES: &[&str] = &[
-    "Reorder",
-    "Encode",
     "MinmaxMipmap",
     "SoftShadow",
     "Freeform",
@@ -230,6 +228,22 @@ pub fn percent<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = f64::deserialize(d)?;
     check::<D, _>(v, (0.0..=100.0).contains(&v), |v| {
         format!("out of range: {v} (a percentage in [0, 100])")
+    })
+}
+
+/// Reorder passes: 0, 1 or 2.
+pub fn zero_to_two<'de, D: Deserializer<'de>>(d: D) -> Result<u8, D::Error> {
+    let v = u8::deserialize(d)?;
+    check::<D, _>(v, v <= 2, |v| {
+        format!("out of range: {v} (reorder passes are 0, 1 or 2)")
+    })
+}
+
+/// A texture side: a multiple of 4, at least 4.
+pub fn texture_size<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    let v = u32::deserialize(d)?;
+    check::<D, _>(v, v >= 4 && v % 4 == 0, |v| {
+        format!("out of range: {v} (a texture size is a positive multiple of 4)")
     })
 }
 

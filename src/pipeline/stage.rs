@@ -33,6 +33,10 @@ pub enum Stage {
     FormFactors(crate::radiosity::stages::FormFactorsKnobs),
     /// k-bounce or infinite-bounce transport matrix (`crate::radiosity::transport`).
     Transport(crate::radiosity::stages::TransportKnobs),
+    /// Greedy reordering of the transport matrix (src/compress/reorder.rs).
+    Reorder(crate::compress::stages::ReorderKnobs),
+    /// Split, log map and block-compress the transport (src/compress/).
+    Encode(crate::compress::stages::EncodeKnobs),
 }
 
 /// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
@@ -42,6 +46,8 @@ pub enum StageKind {
     Voxelize,
     FormFactors,
     Transport,
+    Reorder,
+    Encode,
 }
 
 impl Stage {
@@ -51,6 +57,8 @@ impl Stage {
             Stage::Voxelize(_) => StageKind::Voxelize,
             Stage::FormFactors(_) => StageKind::FormFactors,
             Stage::Transport(_) => StageKind::Transport,
+            Stage::Reorder(_) => StageKind::Reorder,
+            Stage::Encode(_) => StageKind::Encode,
         }
     }
 
@@ -60,6 +68,8 @@ impl Stage {
             Stage::Voxelize(k) => k,
             Stage::FormFactors(k) => k,
             Stage::Transport(k) => k,
+            Stage::Reorder(k) => k,
+            Stage::Encode(k) => k,
         }
     }
 }
@@ -71,6 +81,8 @@ impl StageKind {
             StageKind::Voxelize => "voxelize",
             StageKind::FormFactors => "form_factors",
             StageKind::Transport => "transport",
+            StageKind::Reorder => "reorder",
+            StageKind::Encode => "encode",
         }
     }
 
@@ -78,6 +90,7 @@ impl StageKind {
     pub fn input_kind(self) -> &'static str {
         match self {
             StageKind::Voxelize | StageKind::FormFactors | StageKind::Transport => "scene",
+            StageKind::Reorder | StageKind::Encode => "scene",
         }
     }
 
@@ -87,6 +100,7 @@ impl StageKind {
             StageKind::Voxelize => &[],
             StageKind::FormFactors => &[StageKind::Voxelize],
             StageKind::Transport => &[StageKind::Voxelize, StageKind::FormFactors],
+            StageKind::Reorder | StageKind::Encode => &[StageKind::Transport],
         }
     }
 }

@@ -388,9 +388,10 @@ impl StageRun for TransportKnobs {
         );
         rec.facts
             .insert("bounces".into(), format!("{:?}", self.bounces));
+        // Later stages (reorder, encode) take the matrix as the one transport type.
         ws.put(
             TRANSPORT_FILE,
-            (vec![t.channels as u64, n as u64, n as u64], t.values) as Matrix,
+            crate::compress::TransportMatrix::new(t.channels, n, t.values)?,
         );
         Ok(rec)
     }

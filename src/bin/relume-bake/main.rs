@@ -1,6 +1,7 @@
 //! `relume-bake`: the offline toolchain. Thin: parse arguments into a validated plan, call the
 //! library, show progress, print errors with their cause chain, exit with a code per cause.
 
+mod compress;
 mod radiosity;
 mod ui;
 
@@ -91,6 +92,8 @@ enum Command {
         #[command(flatten)]
         knobs: LoadKnobs,
     },
+    #[command(flatten)]
+    Compress(compress::CompressCommand),
 }
 
 #[derive(Args, Clone)]
@@ -244,6 +247,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         }
         Command::Inspect { baked_dir } => inspect(baked_dir, json),
         Command::Radiosity(c) => radiosity::run(c, json, cli.global.quiet, ui),
+        Command::Compress(c) => compress::run(c, ui, json, cli.global.quiet),
         Command::Load { file, knobs } => {
             let loaded = load_any(
                 file,

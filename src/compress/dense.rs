@@ -1,0 +1,555 @@
+//! The dense part as a texture: the encodings of the `encode` stage's `encoding` knob, their
+//! per-strip encoders and their per-block decoders (DESIGN.md §3 "Compression" steps 3–4).
+//!
+//! Layout: the matrix is padded with zeros to `padded = 4·⌈n/4⌉`. Block encodings store blocks
+//! in row-major block order (block (by, bx) covers rows 4by..4by+4, columns 4bx..4bx+4);
+//! F16/F32 store texels row-major. RGB encodings (BC1, BC6H) have one layer whose R, G, B are
+//! the channels (a grey matrix repeats its one channel); per-channel encodings (BC4, F16, F32)
+//! have one layer per channel.
+//!
+//! Error feedback (`feedback: true`, beyond the seed): blocks of a block row are encoded left
+//! to right, and each row carries the running linear error `Σ (S − decoded)` of the blocks before
+//! it into the next block's target (spread over the block's entries in proportion to their
+//! values, at most doubling or halving any entry). Row sums — and so the gathered light for any
+//! light that varies slowly along the reordered columns — stay close to exact, while each entry
+//! keeps the encoding's own per-entry error.
+
+use super::bc1;
+use super::blocks;
+use super::logmap::LogMap;
+use super::{Sidecar, TransportMatrix};
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// How the dense part is stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum DenseEncoding {
+    /// The seed's: 8-bit log codes of the three channels as one BC1 texel (0.5 byte/entry).
+    Bc1Log,
+    /// 8-bit log codes, one BC4 texture layer per channel (0.5 byte/entry/channel).
+    Bc4Log,
+    /// BC6H unsigned half float, RGB, values divided by the channel maximum (1 byte/entry).
+    Bc6h,
+    /// Half floats divided by the channel maximum, one layer per channel (2 bytes/entry/channel).
+    F16,
+    /// f32, one layer per channel (uncompressed reference, 4 bytes/entry/channel).
+    F32,
+}
+
+impl DenseEncoding {
+    /// All encodings, for sweeps.
+    pub const ALL: [DenseEncoding; 5] = [
+        DenseEncoding::Bc1Log,
+        DenseEncoding::Bc4Log,
+        DenseEncoding::Bc6h,
+        DenseEncoding::F16,
+        DenseEncoding::F32,
+    ];
+
+    /// Does this encoding use the log mapping?
+    pub fn is_log(self) -> bool {
+        matches!(self, DenseEncoding::Bc1Log | DenseEncoding::Bc4Log)
+    }
+
+    /// One layer holding all channels (RGB texels)?
+    pub fn is_rgb(self) -> bool {
+        matches!(self, DenseEncoding::Bc1Log | DenseEncoding::Bc6h)
+    }
+
+    /// Bytes of one layer's 4x4 block (or 16 texels).
+    pub fn block_bytes(self) -> usize {
+        match self {
+            DenseEncoding::Bc1Log | DenseEncoding::Bc4Log => 8,
+            DenseEncoding::Bc6h => 16,
+            DenseEncoding::F16 => 32,
+            DenseEncoding::F32 => 64,
+        }
+    }
+
+    /// Is the layer stored as 4x4 blocks (else row-major texels)?
+    pub fn is_block_compressed(self) -> bool {
+        !matches!(self, DenseEncoding::F16 | DenseEncoding::F32)
+    }
+
+    /// Name used in files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            DenseEncoding::Bc1Log => "bc1_log",
+            DenseEncoding::Bc4Log => "bc4_log",
+            DenseEncoding::Bc6h => "bc6h",
+            DenseEncoding::F16 => "f16",
+            DenseEncoding::F32 => "f32",
+        }
+    }
+}
+
+/// Knobs of the dense encoding.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EncodeOptions {
+    pub encoding: DenseEncoding,
+    /// Natural-log range of the log mapping (the seed's 25).
+    pub log_range: f32,
+    /// Carry each row's running error into the next block (see the module doc).
+    pub feedback: bool,
+    /// Instead of zeroing the sidecar's entries in the dense part (the seed), fill them like
+    /// padding and store `S − decoded` in the sidecar (exact sum, tighter blocks).
+    pub fill_holes: bool,
+}
+
+/// The seed's scheme (Bc1Log, range 25, no feedback, zeroed holes). The `encode` stage's
+/// defaults differ (see `stages::EncodeKnobs`).
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        EncodeOptions {
+            encoding: DenseEncoding::Bc1Log,
+            log_range: super::logmap::SEED_RANGE,
+            feedback: false,
+            fill_holes: false,
+        }
+    }
+}
+
+/// The encoded dense part.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseTexture {
+    pub encoding: DenseEncoding,
+    pub n: usize,
+    pub channels: usize,
+    /// `n` rounded up to a multiple of 4: the texture's width and height.
+    pub padded: usize,
+    /// Per channel: the log mapping (log encodings), or `scale` = the value stored as 1.0
+    /// (BC6H, F16; 1.0 for F32).
+    pub maps: Vec<LogMap>,
+    /// One layer (RGB encodings) or one per channel.
+    pub layers: Vec<Vec<u8>>,
+}
+
+/// Linear values of one 4x4 block: `[channel][4·y + x]`.
+pub type BlockValues = [[f32; 16]; 3];
+
+/// Decoding tables of a texture (built once per gather).
+pub struct Decoder<'a> {
+    tex: &'a DenseTexture,
+    layers: Vec<&'a [u8]>,
+    luts: Vec<[f32; 256]>,
+}
+
+impl DenseTexture {
+    /// Bytes of the texture payload (all layers).
+    pub fn bytes(&self) -> usize {
+        self.layers.iter().map(Vec::len).sum()
+    }
+
+    /// Number of layers the encoding uses for `channels`.
+    pub fn layer_count(encoding: DenseEncoding, channels: usize) -> usize {
+        if encoding.is_rgb() {
+            1
+        } else {
+            channels
+        }
+    }
+
+    /// Decoding tables for [`Decoder::block`].
+    pub fn decoder(&self) -> Decoder<'_> {
+        Decoder {
+            tex: self,
+            layers: self.layers.iter().map(Vec::as_slice).collect(),
+            luts: self.maps.iter().map(LogMap::lut).collect(),
+        }
+    }
+
+    /// Check sizes against the header fields (for textures read from files).
+    pub fn validate(&self) -> Result<()> {
+        let blocks = (self.padded / 4) * (self.padded / 4);
+        let want = blocks * self.encoding.block_bytes();
+        if self.padded != 4 * self.n.div_ceil(4)
+            || self.maps.len() != self.channels
+            || self.layers.len() != Self::layer_count(self.encoding, self.channels)
+            || self.layers.iter().any(|l| l.len() != want)
+        {
+            return Err(Error::Internal(format!(
+                "dense texture sizes do not match a {}x{} {} matrix",
+                self.n,
+                self.n,
+                self.encoding.name()
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Decoder<'_> {
+    /// Linear values of block (by, bx), channels beyond `channels` left zero.
+    #[inline]
+    pub fn block(&self, by: usize, bx: usize, out: &mut BlockValues) {
+        let t = self.tex;
+        let bw = t.padded / 4;
+        decode_block_at(
+            t.encoding,
+            t.channels,
+            &t.maps,
+            &self.luts,
+            &self.layers,
+            bw,
+            by,
+            bx,
+            out,
+        );
+    }
+}
+
+/// Decode block (by, bx) of layers whose rows are `bw` blocks wide (block encodings) or
+/// `4·bw` texels wide (F16, F32). A plain function: the WGSL gather ports this.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn decode_block_at(
+    encoding: DenseEncoding,
+    channels: usize,
+    maps: &[LogMap],
+    luts: &[[f32; 256]],
+    layers: &[&[u8]],
+    bw: usize,
+    by: usize,
+    bx: usize,
+    out: &mut BlockValues,
+) {
+    let bb = encoding.block_bytes();
+    let k = (by * bw + bx) * bb;
+    match encoding {
+        DenseEncoding::Bc1Log => {
+            let texels = bc1::decode_block(&layers[0][k..k + bb]);
+            if channels == 1 {
+                for t in 0..16 {
+                    out[0][t] = luts[0][texels[t][1] as usize];
+                }
+            } else {
+                for t in 0..16 {
+                    for c in 0..3 {
+                        out[c][t] = luts[c][texels[t][c] as usize];
+                    }
+                }
+            }
+        }
+        DenseEncoding::Bc4Log => {
+            for c in 0..channels {
+                let blk = &layers[c][k..k + bb];
+                let pal = blocks::bc4_palette(blk);
+                let mut vals = [0.0f32; 8];
+                for (v, p) in vals.iter_mut().zip(pal) {
+                    *v = maps[c].decode_real(p);
+                }
+                let idx = blocks::bc4_indices(blk);
+                for t in 0..16 {
+                    out[c][t] = vals[idx[t] as usize];
+                }
+            }
+        }
+        DenseEncoding::Bc6h => {
+            let texels = blocks::bc6h_decode_block(&layers[0][k..k + bb]);
+            let src = if channels == 1 { 1 } else { 0 };
+            for c in 0..channels {
+                for t in 0..16 {
+                    out[c][t] = texels[t][if channels == 1 { src } else { c }] * maps[c].scale;
+                }
+            }
+        }
+        DenseEncoding::F16 | DenseEncoding::F32 => {
+            let w = 4 * bw;
+            let size = if encoding == DenseEncoding::F16 { 2 } else { 4 };
+            for c in 0..channels {
+                for y in 0..4 {
+                    let o = ((4 * by + y) * w + 4 * bx) * size;
+                    let row = &layers[c][o..o + 4 * size];
+                    for x in 0..4 {
+                        let v = if size == 2 {
+                            half::f16::from_le_bytes([row[2 * x], row[2 * x + 1]]).to_f32()
+                        } else {
+                            f32::from_le_bytes(row[4 * x..4 * x + 4].try_into().unwrap())
+                        };
+                        out[c][4 * y + x] = v * maps[c].scale;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Per-channel maps for the dense part `m` (scale = the channel's largest value).
+pub fn channel_maps(m: &TransportMatrix, opts: &EncodeOptions) -> Vec<LogMap> {
+    let nn = m.n * m.n;
+    (0..m.channels)
+        .map(|c| {
+            let max = m.data[c * nn..(c + 1) * nn]
+                .par_iter()
+                .fold(|| 0.0f32, |a, &b| a.max(b))
+                .reduce(|| 0.0f32, f32::max);
+            match opts.encoding {
+                DenseEncoding::F32 => LogMap {
+                    scale: 1.0,
+                    range: opts.log_range,
+                },
+                _ => {
+                    let mut map = LogMap::seed(max);
+                    map.range = opts.log_range;
+                    map
+                }
+            }
+        })
+        .collect()
+}
+
+/// Encode the dense part `m` (entries already split off are zero). Parallel over block rows;
+/// the output does not depend on the thread count.
+///
+/// `holes` (optional) marks entries whose dense value does not matter (they were moved to the
+/// sidecar, which will hold the residual): they are filled like padding and ignored by the
+/// error feedback.
+pub fn encode_dense(
+    m: &TransportMatrix,
+    opts: &EncodeOptions,
+    holes: Option<&Sidecar>,
+) -> Result<DenseTexture> {
+    if !(opts.log_range.is_finite() && opts.log_range > 0.0) {
+        return Err(Error::knob(format!(
+            "log range {} must be a positive number",
+            opts.log_range
+        )));
+    }
+    let (n, ch) = (m.n, m.channels);
+    let padded = 4 * n.div_ceil(4);
+    let bw = padded / 4;
+    let maps = channel_maps(m, opts);
+    let luts: Vec<[f32; 256]> = maps.iter().map(LogMap::lut).collect();
+    let nl = DenseTexture::layer_count(opts.encoding, ch);
+    let row_bytes = bw * opts.encoding.block_bytes();
+    let rows: Vec<Vec<Vec<u8>>> = (0..bw)
+        .into_par_iter()
+        .map(|by| {
+            let strip = Strip::gather(m, by, padded, holes);
+            if opts.feedback {
+                encode_row_feedback(&strip, opts.encoding, &maps, &luts, nl)
+            } else {
+                encode_strip(&strip.values, padded, ch, opts.encoding, &maps, nl)
+            }
+        })
+        .collect();
+    let mut layers = vec![Vec::with_capacity(row_bytes * bw); nl];
+    for row in rows {
+        for (l, part) in layers.iter_mut().zip(row) {
+            l.extend_from_slice(&part);
+        }
+    }
+    Ok(DenseTexture {
+        encoding: opts.encoding,
+        n,
+        channels: ch,
+        padded,
+        maps,
+        layers,
+    })
+}
+
+/// Four rows of the matrix: `values[c][y·width + x]`, with a mask of the texels that matter.
+/// Texels that do not matter — padding beyond `n`, and (with hole filling) the entries moved to
+/// the sidecar — copy their nearest mattering neighbour in the row (or the row above), so they
+/// never widen a block's range.
+struct Strip {
+    values: Vec<Vec<f32>>,
+    care: Vec<bool>,
+    width: usize,
+    channels: usize,
+}
+
+impl Strip {
+    fn gather(m: &TransportMatrix, by: usize, padded: usize, holes: Option<&Sidecar>) -> Strip {
+        let (n, ch) = (m.n, m.channels);
+        let mut care = vec![false; 4 * padded];
+        for y in 0..4 {
+            let i = 4 * by + y;
+            if i < n {
+                care[y * padded..y * padded + n].fill(true);
+                if let Some(h) = holes {
+                    for k in h.row_ptr[i] as usize..h.row_ptr[i + 1] as usize {
+                        care[y * padded + h.cols[k] as usize] = false;
+                    }
+                }
+            }
+        }
+        let values = (0..ch)
+            .map(|c| {
+                let mut v = vec![0.0f32; 4 * padded];
+                for y in 0..4 {
+                    let i = 4 * by + y;
+                    if i < n {
+                        v[y * padded..y * padded + n].copy_from_slice(m.row(c, i));
+                    }
+                    fill_row(
+                        &mut v[y * padded..(y + 1) * padded],
+                        &care[y * padded..(y + 1) * padded],
+                    );
+                    if y > 0 && !care[y * padded..(y + 1) * padded].iter().any(|&b| b) {
+                        v.copy_within((y - 1) * padded..y * padded, y * padded);
+                    }
+                }
+                v
+            })
+            .collect();
+        Strip {
+            values,
+            care,
+            width: padded,
+            channels: ch,
+        }
+    }
+}
+
+/// Give every don't-care texel the value of the nearest texel that matters to its left (or,
+/// at the start of the row, to its right).
+fn fill_row(v: &mut [f32], care: &[bool]) {
+    let Some(first) = care.iter().position(|&b| b) else {
+        return;
+    };
+    let mut last = v[first];
+    for x in 0..v.len() {
+        if care[x] {
+            last = v[x];
+        } else {
+            v[x] = last;
+        }
+    }
+    let head = v[first];
+    v[..first].fill(head);
+}
+
+/// Encode 4 rows of linear values (`values[c][y·width + x]`) into each layer's bytes.
+fn encode_strip(
+    values: &[Vec<f32>],
+    width: usize,
+    channels: usize,
+    encoding: DenseEncoding,
+    maps: &[LogMap],
+    nl: usize,
+) -> Vec<Vec<u8>> {
+    let blocks_w = width / 4;
+    let mut out: Vec<Vec<u8>> = vec![vec![0u8; blocks_w * encoding.block_bytes()]; nl];
+    let src = |c: usize| if channels == 1 { 0 } else { c };
+    match encoding {
+        DenseEncoding::Bc1Log => {
+            let mut rgba = vec![0u8; 4 * width * 4];
+            for t in 0..4 * width {
+                for c in 0..3 {
+                    rgba[4 * t + c] = maps[src(c)].encode(values[src(c)][t]);
+                }
+                rgba[4 * t + 3] = 255;
+            }
+            bc1::encode_strip(&rgba, width, &mut out[0]);
+        }
+        DenseEncoding::Bc4Log => {
+            for c in 0..channels {
+                let r8: Vec<u8> = values[c].iter().map(|&v| maps[c].encode(v)).collect();
+                blocks::bc4_encode_strip(&r8, width, &mut out[c]);
+            }
+        }
+        DenseEncoding::Bc6h => {
+            let mut rgba = vec![0u8; 4 * width * 8];
+            for t in 0..4 * width {
+                for c in 0..3 {
+                    let map = &maps[src(c)];
+                    let v = if map.scale > 0.0 {
+                        (values[src(c)][t] / map.scale).max(0.0)
+                    } else {
+                        0.0
+                    };
+                    let h = half::f16::from_f32(v).to_le_bytes();
+                    rgba[8 * t + 2 * c..8 * t + 2 * c + 2].copy_from_slice(&h);
+                }
+                let one = half::f16::ONE.to_le_bytes();
+                rgba[8 * t + 6..8 * t + 8].copy_from_slice(&one);
+            }
+            blocks::bc6h_encode_strip(&rgba, width, &mut out[0]);
+        }
+        DenseEncoding::F16 => {
+            for c in 0..channels {
+                let s = maps[c].scale;
+                for (t, v) in values[c].iter().enumerate() {
+                    let x = if s > 0.0 { v / s } else { 0.0 };
+                    out[c][2 * t..2 * t + 2].copy_from_slice(&half::f16::from_f32(x).to_le_bytes());
+                }
+            }
+        }
+        DenseEncoding::F32 => {
+            for c in 0..channels {
+                for (t, v) in values[c].iter().enumerate() {
+                    out[c][4 * t..4 * t + 4].copy_from_slice(&v.to_le_bytes());
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Encode one block row left to right with error feedback (module doc).
+fn encode_row_feedback(
+    strip: &Strip,
+    encoding: DenseEncoding,
+    maps: &[LogMap],
+    luts: &[[f32; 256]],
+    nl: usize,
+) -> Vec<Vec<u8>> {
+    let (width, ch) = (strip.width, strip.channels);
+    let bb = encoding.block_bytes();
+    let mut out: Vec<Vec<u8>> = vec![Vec::with_capacity(width / 4 * bb); nl];
+    let mut carry = [[0.0f64; 4]; 3];
+    let mut target: Vec<Vec<f32>> = vec![vec![0.0; 16]; ch];
+    let mut dec = [[0.0f32; 16]; 3];
+    for bx in 0..width / 4 {
+        for c in 0..ch {
+            for y in 0..4 {
+                let row = &strip.values[c][y * width + 4 * bx..y * width + 4 * bx + 4];
+                let sum: f64 = row.iter().map(|&v| v.max(0.0) as f64).sum();
+                let factor = if sum > 0.0 {
+                    (1.0 + carry[c][y] / sum).clamp(0.5, 2.0)
+                } else {
+                    1.0
+                };
+                for x in 0..4 {
+                    target[c][4 * y + x] = (row[x].max(0.0) as f64 * factor) as f32;
+                }
+            }
+        }
+        let enc = encode_strip(&target, 4, ch, encoding, maps, nl);
+        let layers: Vec<&[u8]> = enc.iter().map(Vec::as_slice).collect();
+        decode_block_at(encoding, ch, maps, luts, &layers, 1, 0, 0, &mut dec);
+        for c in 0..ch {
+            for y in 0..4 {
+                for x in 0..4 {
+                    let t = y * width + 4 * bx + x;
+                    if strip.care[t] {
+                        carry[c][y] += strip.values[c][t] as f64 - dec[c][4 * y + x] as f64;
+                    }
+                }
+            }
+        }
+        for (o, e) in out.iter_mut().zip(&enc) {
+            o.extend_from_slice(e);
+        }
+    }
+    // F16/F32 store texels row-major: the per-block bytes above are 4x4 row-major blocks;
+    // reorder them into 4 texel rows.
+    if !encoding.is_block_compressed() {
+        let size = bb / 16;
+        for layer in out.iter_mut() {
+            let mut rows = vec![0u8; layer.len()];
+            for bx in 0..width / 4 {
+                for y in 0..4 {
+                    let src = bx * bb + y * 4 * size;
+                    let dst = (y * width + 4 * bx) * size;
+                    rows[dst..dst + 4 * size].copy_from_slice(&layer[src..src + 4 * size]);
+                }
+            }
+            *layer = rows;
+        }
+    }
+    out
+}
