@@ -6,7 +6,7 @@ mod common;
 use common::{bake, data, expect_code};
 use glam::Vec3;
 use relume::gpu::{readback, Gpu};
-use relume::player::{Player, Sun};
+use relume::player::{Player, PlayerOptions, Sun, TransportChoice};
 use relume::radiosity::PatchSet;
 use relume::render::direct::{corner_indirect, gather_dense, patch_exitance};
 use relume::render::mesh_reference::FrameSettings;
@@ -71,33 +71,55 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = bake_pipeline(tmp.path(), "pipelines/cornell.ron");
     let (w, h) = (240u32, 180u32);
-    let mut player = Player::load(&gpu, &dir, w, h).unwrap();
-    let camera = player.default_camera();
     let s = FrameSettings::default();
     let mut timer = relume::gpu::timing::PassTimer::new(&gpu, 48);
-    player.render(&gpu, &camera, &s, &mut timer).unwrap();
-    let gpu_img = player.read_image(&gpu).unwrap();
-
-    // CPU twins, step by step, from the same bake.
     let set: PatchSet = relume::baked::read_postcard(&dir.join("patches.bin")).unwrap();
-    let (shape, transport) = relume::baked::read_npy_f32(&dir.join("transport.npy")).unwrap();
-    let (channels, n) = (shape[0] as usize, shape[1] as usize);
     let lights = Vec::new(); // the Cornell box is lit by its emitter only
     let e = patch_exitance(&set, &lights, &s, &|_, _, _, _| true);
-    let b = gather_dense(&transport, channels, n, &e);
-    let corners = corner_indirect(&set, &b);
-    let Player::Mesh(m) = &player;
-    let rt = &m.radiosity.as_ref().expect("the bake has a transport").1;
+    let n = set.patches.len();
     let flat = |v: &[f32]| {
         v.chunks_exact(4)
             .flat_map(|c| [c[0], c[1], c[2]])
             .collect::<Vec<f32>>()
     };
+
+    // The dense reference transport: the dense kernel against its CPU twin.
+    let opts = PlayerOptions {
+        transport: TransportChoice::Dense,
+        decode: None,
+    };
+    let mut dense_player = Player::load(&gpu, &dir, &opts, w, h).unwrap();
+    let camera = dense_player.default_camera();
+    dense_player.render(&gpu, &camera, &s, &mut timer).unwrap();
+    let (shape, transport) = relume::baked::read_npy_f32(&dir.join("transport.npy")).unwrap();
+    let b_dense = gather_dense(&transport, shape[0] as usize, n, &e);
+    let Player::Mesh(m) = &dense_player;
+    let rt = &m.radiosity.as_ref().expect("the bake has a transport").1;
+    // Same f32 summation order; lavapipe may fuse multiply-adds: a few ulp of the largest value.
+    rel_close(
+        &flat(&readback::read_f32(&gpu, &rt.indirect).unwrap())[..3 * n],
+        &b_dense.concat(),
+        1e-5,
+        "dense gather",
+    );
+
+    // The default: the encoded transport, hardware BC decode when available.
+    let mut player = Player::load(&gpu, &dir, &PlayerOptions::default(), w, h).unwrap();
+    player.render(&gpu, &camera, &s, &mut timer).unwrap();
+    let gpu_img = player.read_image(&gpu).unwrap();
+    let encoded = relume::compress::stages::read_encoded(&dir).unwrap();
+    let e_flat: Vec<f32> = (0..3).flat_map(|c| e.iter().map(move |v| v[c])).collect();
+    let b_flat = relume::compress::gather(&encoded, &e_flat);
+    let b: Vec<[f32; 3]> = (0..n)
+        .map(|i| [b_flat[i], b_flat[n + i], b_flat[2 * n + i]])
+        .collect();
+    let corners = corner_indirect(&set, &b);
+    let Player::Mesh(m) = &player;
+    let rt = &m.radiosity.as_ref().expect("the bake has a transport").1;
     let e_gpu = flat(&readback::read_f32(&gpu, &rt.exitance).unwrap());
     rel_close(&e_gpu[..3 * n], &e.concat(), 1e-6, "direct exitance");
     let b_gpu = flat(&readback::read_f32(&gpu, &rt.indirect).unwrap());
-    // Same f32 summation order; lavapipe may fuse multiply-adds: a few ulp of the largest value.
-    rel_close(&b_gpu[..3 * n], &b.concat(), 1e-5, "gather");
+    rel_close(&b_gpu[..3 * n], &b.concat(), 1e-5, "compressed gather");
     let c_gpu = readback::read_f32(&gpu, &m.renderer.indirect).unwrap();
     rel_close(&c_gpu[..corners.len()], &corners, 1e-5, "corner transfer");
 
@@ -167,7 +189,7 @@ fn punctual_lights_with_shadow_maps_match_ray_traced_shadows() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = bake_pipeline(tmp.path(), "pipelines/gltf-room.ron");
     let (w, h) = (200u32, 150u32);
-    let mut player = Player::load(&gpu, &dir, w, h).unwrap();
+    let mut player = Player::load(&gpu, &dir, &Default::default(), w, h).unwrap();
     player
         .set_sun(
             &gpu,

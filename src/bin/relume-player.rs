@@ -6,9 +6,10 @@ mod window;
 
 use clap::Parser;
 use relume::error::{exit, Error, Result};
+use relume::gpu::compressed_gather::DecodePath;
 use relume::gpu::timing::PassTimer;
 use relume::gpu::{BackendChoice, Gpu};
-use relume::player::{FrameTimes, Player, Sun};
+use relume::player::{FrameTimes, Player, PlayerOptions, Sun, TransportChoice};
 use relume::render::camera::Camera;
 use relume::render::mesh_reference::FrameSettings;
 use serde::Serialize;
@@ -63,9 +64,30 @@ struct Cli {
     /// Leave out shadows
     #[arg(long)]
     no_shadows: bool,
+    /// Transport to gather from: the encoded one when the bake has it (auto), or the dense
+    /// `transport.npy` reference
+    #[arg(long, value_enum, default_value_t = TransportArg::Auto)]
+    transport: TransportArg,
+    /// How BC blocks are decoded: by the texture unit (hardware, needs BC support) or by WGSL
+    /// decoders over a storage buffer (shader). Default: hardware when the adapter has it
+    #[arg(long, value_enum)]
+    bc_decode: Option<DecodeArg>,
     /// No progress output
     #[arg(short, long)]
     quiet: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum TransportArg {
+    Auto,
+    Dense,
+    Compressed,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum DecodeArg {
+    Hardware,
+    Shader,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -166,6 +188,20 @@ fn settings(cli: &Cli) -> FrameSettings {
     }
 }
 
+fn player_options(cli: &Cli) -> PlayerOptions {
+    PlayerOptions {
+        transport: match cli.transport {
+            TransportArg::Auto => TransportChoice::Auto,
+            TransportArg::Dense => TransportChoice::Dense,
+            TransportArg::Compressed => TransportChoice::Compressed,
+        },
+        decode: cli.bc_decode.map(|d| match d {
+            DecodeArg::Hardware => DecodePath::Hardware,
+            DecodeArg::Shader => DecodePath::Shader,
+        }),
+    }
+}
+
 fn backend(cli: &Cli) -> Option<BackendChoice> {
     cli.backend.map(|b| match b {
         BackendArg::Vulkan => BackendChoice::Vulkan,
@@ -184,6 +220,7 @@ fn run(cli: &Cli) -> Result<()> {
             cli.camera,
             settings(cli),
             backend(cli),
+            player_options(cli),
         );
     }
     let gpu = Gpu::new(backend(cli))?;
@@ -194,7 +231,7 @@ fn run(cli: &Cli) -> Result<()> {
         );
     }
     let (w, h) = cli.size;
-    let mut player = Player::load(&gpu, &cli.baked_dir, w, h)?;
+    let mut player = Player::load(&gpu, &cli.baked_dir, &player_options(cli), w, h)?;
     let camera = cli.camera.unwrap_or_else(|| player.default_camera());
     let s = settings(cli);
     std::fs::create_dir_all(&cli.out)

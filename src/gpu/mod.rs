@@ -6,6 +6,7 @@
 //! validation test alike.
 
 pub mod blit;
+pub mod compressed_gather;
 pub mod compute;
 pub mod mesh_renderer;
 pub mod radiosity_runtime;
@@ -157,34 +158,22 @@ impl Gpu {
 }
 
 /// The WGSL files of `shaders/`, by file name, embedded at compile time.
-pub const SHADERS: &[(&str, &str)] = &[
-    ("blit.wgsl", include_str!("../../shaders/blit.wgsl")),
-    ("common.wgsl", include_str!("../../shaders/common.wgsl")),
-    (
-        "corner_transfer.wgsl",
-        include_str!("../../shaders/corner_transfer.wgsl"),
-    ),
-    (
-        "direct_light.wgsl",
-        include_str!("../../shaders/direct_light.wgsl"),
-    ),
-    (
-        "gather_dense.wgsl",
-        include_str!("../../shaders/gather_dense.wgsl"),
-    ),
-    ("lighting.wgsl", include_str!("../../shaders/lighting.wgsl")),
-    (
-        "mesh_shade.wgsl",
-        include_str!("../../shaders/mesh_shade.wgsl"),
-    ),
-    (
-        "shadow_depth.wgsl",
-        include_str!("../../shaders/shadow_depth.wgsl"),
-    ),
-    (
-        "tonemap_test.wgsl",
-        include_str!("../../shaders/tonemap_test.wgsl"),
-    ),
+/// Embed `shaders/NAME` for each name.
+macro_rules! shaders {
+    ($($name:literal),* $(,)?) => { &[$(($name, include_str!(concat!("../../shaders/", $name)))),*] };
+}
+
+pub const SHADERS: &[(&str, &str)] = shaders![
+    "blit.wgsl",
+    "common.wgsl",
+    "corner_transfer.wgsl",
+    "direct_light.wgsl",
+    "gather_compressed.wgsl",
+    "gather_dense.wgsl",
+    "lighting.wgsl",
+    "mesh_shade.wgsl",
+    "shadow_depth.wgsl",
+    "tonemap_test.wgsl",
 ];
 
 fn raw_source(name: &str) -> Result<(&'static str, &'static str)> {

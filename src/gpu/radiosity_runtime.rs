@@ -3,6 +3,7 @@
 //! encoding), and the transfer to the mesh's triangle corners (`corner_transfer.wgsl`), which
 //! writes the mesh renderer's per-corner `indirect` vertex buffer.
 
+use super::compressed_gather::{CompressedGather, DecodePath};
 use super::compute;
 use super::mesh_renderer::MeshRenderer;
 use super::timing::PassTimer;
@@ -18,6 +19,32 @@ pub struct DenseTransport<'a> {
     pub data: &'a [f32],
 }
 
+/// Where the runtime's transport comes from.
+pub enum TransportSource<'a> {
+    /// The uncompressed `transport.npy` (the reference encoding).
+    Dense(DenseTransport<'a>),
+    /// The `encode` stage's output, decoded by the given path.
+    Compressed(&'a crate::compress::EncodedTransport, DecodePath),
+}
+
+impl TransportSource<'_> {
+    fn n(&self) -> usize {
+        match self {
+            TransportSource::Dense(d) => d.n,
+            TransportSource::Compressed(t, _) => t.dense.n,
+        }
+    }
+}
+
+/// The gather pass of either source.
+enum Gather {
+    Dense {
+        pipeline: wgpu::ComputePipeline,
+        groups: Vec<wgpu::BindGroup>,
+    },
+    Compressed(CompressedGather),
+}
+
 /// GPU buffers and pipelines of the radiosity passes.
 pub struct RadiosityRuntime {
     n: u32,
@@ -25,8 +52,7 @@ pub struct RadiosityRuntime {
     direct: wgpu::ComputePipeline,
     direct_params: wgpu::Buffer,
     direct_group: wgpu::BindGroup,
-    gather: wgpu::ComputePipeline,
-    gather_groups: Vec<wgpu::BindGroup>,
+    gather: Gather,
     transfer: wgpu::ComputePipeline,
     transfer_group: wgpu::BindGroup,
     /// E per patch (vec4).
@@ -40,14 +66,14 @@ impl RadiosityRuntime {
     pub fn new(
         gpu: &Gpu,
         set: &PatchSet,
-        transport: DenseTransport<'_>,
+        transport: TransportSource<'_>,
         renderer: &MeshRenderer,
     ) -> Result<Self> {
         let n = set.patches.len();
-        if transport.n != n || !(transport.channels == 1 || transport.channels == 3) {
+        if transport.n() != n {
             return Err(Error::Internal(format!(
-                "transport is {}x{}x{}, the bake has {n} patches",
-                transport.channels, transport.n, transport.n
+                "transport is {0}x{0}, the bake has {n} patches",
+                transport.n()
             )));
         }
         if set.corners.len() != renderer.corners() as usize {
@@ -55,14 +81,6 @@ impl RadiosityRuntime {
                 "transfer lists cover {} corners, the mesh has {}",
                 set.corners.len(),
                 renderer.corners()
-            )));
-        }
-        let per_channel = (n * n * 4) as u64;
-        if per_channel > gpu.info.max_storage_buffer_binding_size {
-            return Err(Error::limit(format!(
-                "an uncompressed {n}x{n} transport channel needs {} MiB, over the adapter's {} MiB storage binding limit; encode it (stage `encode`)",
-                per_channel >> 20,
-                gpu.info.max_storage_buffer_binding_size >> 20
             )));
         }
         let samples: Vec<[f32; 4]> = set
@@ -170,32 +188,12 @@ impl RadiosityRuntime {
             ],
         });
 
-        let gather = compute::pipeline(gpu, "gather_dense.wgsl", "main")?;
-        let matrices: Vec<wgpu::Buffer> = (0..transport.channels)
-            .map(|c| {
-                compute::storage(
-                    gpu,
-                    "transport channel",
-                    &transport.data[c * n * n..(c + 1) * n * n],
-                )
-            })
-            .collect();
-        let gather_groups = (0..3u32)
-            .map(|c| {
-                let params = compute::uniform(gpu, "gather params", &[n as u32, c, 0, 0]);
-                let m = &matrices[(c as usize).min(transport.channels - 1)];
-                compute::bind(
-                    gpu,
-                    &gather,
-                    &[
-                        params.as_entire_binding(),
-                        m.as_entire_binding(),
-                        exitance.as_entire_binding(),
-                        indirect.as_entire_binding(),
-                    ],
-                )
-            })
-            .collect();
+        let gather = match transport {
+            TransportSource::Dense(d) => dense_gather(gpu, &d, &exitance, &indirect)?,
+            TransportSource::Compressed(t, path) => {
+                Gather::Compressed(CompressedGather::new(gpu, t, path, &exitance, &indirect)?)
+            }
+        };
 
         let transfer = compute::pipeline(gpu, "corner_transfer.wgsl", "main")?;
         let corners = renderer.corners();
@@ -222,7 +220,6 @@ impl RadiosityRuntime {
             direct_params,
             direct_group,
             gather,
-            gather_groups,
             transfer,
             transfer_group,
             exitance,
@@ -255,16 +252,19 @@ impl RadiosityRuntime {
             pass.set_bind_group(1, &renderer.group1, &[]);
             pass.dispatch_workgroups(groups(self.n), 1, 1);
         }
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("gather"),
-                timestamp_writes: timer.compute("gather"),
-            });
-            pass.set_pipeline(&self.gather);
-            for g in &self.gather_groups {
-                pass.set_bind_group(0, g, &[]);
-                pass.dispatch_workgroups(groups(self.n), 1, 1);
+        match &self.gather {
+            Gather::Dense { pipeline, groups } => {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("gather"),
+                    timestamp_writes: timer.compute("gather"),
+                });
+                pass.set_pipeline(pipeline);
+                for g in groups {
+                    pass.set_bind_group(0, g, &[]);
+                    pass.dispatch_workgroups(groups_for(self.n), 1, 1);
+                }
             }
+            Gather::Compressed(c) => c.record(enc, timer),
         }
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -276,4 +276,59 @@ impl RadiosityRuntime {
             pass.dispatch_workgroups(groups(self.corners), 1, 1);
         }
     }
+}
+
+fn groups_for(count: u32) -> u32 {
+    count.div_ceil(64).max(1)
+}
+
+/// The dense f32 gather: one bind group per colour channel.
+fn dense_gather(
+    gpu: &Gpu,
+    d: &DenseTransport<'_>,
+    exitance: &wgpu::Buffer,
+    indirect: &wgpu::Buffer,
+) -> Result<Gather> {
+    let n = d.n;
+    if !(d.channels == 1 || d.channels == 3) || d.data.len() != d.channels * n * n {
+        return Err(Error::Internal(format!(
+            "dense transport of {} values is not [1 or 3, {n}, {n}]",
+            d.data.len()
+        )));
+    }
+    let per_channel = (n * n * 4) as u64;
+    if per_channel > gpu.info.max_storage_buffer_binding_size {
+        return Err(Error::limit(format!(
+            "an uncompressed {n}x{n} transport channel needs {} MiB, over the adapter's {} MiB storage binding limit; encode it (stage `encode`)",
+            per_channel >> 20,
+            gpu.info.max_storage_buffer_binding_size >> 20
+        )));
+    }
+    let pipeline = compute::pipeline(gpu, "gather_dense.wgsl", "main")?;
+    let matrices: Vec<wgpu::Buffer> = (0..d.channels)
+        .map(|c| {
+            compute::storage(
+                gpu,
+                "transport channel",
+                &d.data[c * n * n..(c + 1) * n * n],
+            )
+        })
+        .collect();
+    let groups = (0..3u32)
+        .map(|c| {
+            let params = compute::uniform(gpu, "gather params", &[n as u32, c, 0, 0]);
+            let m = &matrices[(c as usize).min(d.channels - 1)];
+            compute::bind(
+                gpu,
+                &pipeline,
+                &[
+                    params.as_entire_binding(),
+                    m.as_entire_binding(),
+                    exitance.as_entire_binding(),
+                    indirect.as_entire_binding(),
+                ],
+            )
+        })
+        .collect();
+    Ok(Gather::Dense { pipeline, groups })
 }

@@ -2,10 +2,12 @@
 //! radiosity transfer) indirect light gathered on the GPU.
 
 use super::Sun;
+use super::{PlayerOptions, TransportChoice};
 use crate::baked::{read_scene, Manifest};
 use crate::error::Result;
+use crate::gpu::compressed_gather::DecodePath;
 use crate::gpu::mesh_renderer::MeshRenderer;
-use crate::gpu::radiosity_runtime::{DenseTransport, RadiosityRuntime};
+use crate::gpu::radiosity_runtime::{DenseTransport, RadiosityRuntime, TransportSource};
 use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
 use crate::radiosity::{PatchSet, PATCHES_FILE, TRANSPORT_FILE};
@@ -36,6 +38,7 @@ impl MeshPlayer {
         gpu: &Gpu,
         dir: &Path,
         manifest: &Manifest,
+        opts: &PlayerOptions,
         width: u32,
         height: u32,
     ) -> Result<Self> {
@@ -46,32 +49,7 @@ impl MeshPlayer {
             .iter()
             .map(|l| GpuLight::from_light(l, 1.0, 0))
             .collect();
-        let radiosity = if manifest.file(TRANSPORT_FILE).is_some() {
-            let set: PatchSet = crate::baked::read_postcard(&dir.join(PATCHES_FILE))?;
-            let (shape, data) = crate::baked::read_npy_f32(&dir.join(TRANSPORT_FILE))?;
-            let (channels, n) = match shape.as_slice() {
-                [c, n, m] if n == m => (*c as usize, *n as usize),
-                _ => {
-                    return Err(crate::error::Error::input(
-                        dir.join(TRANSPORT_FILE),
-                        format!("shape {shape:?} is not [channels, n, n]"),
-                    ))
-                }
-            };
-            let rt = RadiosityRuntime::new(
-                gpu,
-                &set,
-                DenseTransport {
-                    channels,
-                    n,
-                    data: &data,
-                },
-                &renderer,
-            )?;
-            Some((set, rt))
-        } else {
-            None
-        };
+        let radiosity = load_radiosity(gpu, dir, manifest, opts, &renderer)?;
         let mut p = MeshPlayer {
             scene,
             renderer,
@@ -143,4 +121,74 @@ impl MeshPlayer {
         gpu.wait();
         Ok(())
     }
+}
+
+/// The bake's light transfer on the GPU: the compressed transport when the bake has one (unless
+/// `opts` asks for the dense reference), else the dense `transport.npy`, else none.
+fn load_radiosity(
+    gpu: &Gpu,
+    dir: &Path,
+    manifest: &Manifest,
+    opts: &PlayerOptions,
+    renderer: &MeshRenderer,
+) -> Result<Option<(PatchSet, RadiosityRuntime)>> {
+    let has_encoded = manifest
+        .file(crate::compress::stages::TRANSFER_FILE)
+        .is_some();
+    let has_dense = manifest.file(TRANSPORT_FILE).is_some();
+    if !has_encoded && !has_dense {
+        return Ok(None);
+    }
+    let set: PatchSet = crate::baked::read_postcard(&dir.join(PATCHES_FILE))?;
+    let use_dense = match opts.transport {
+        TransportChoice::Dense => true,
+        TransportChoice::Compressed => false,
+        TransportChoice::Auto => !has_encoded,
+    };
+    let rt = if use_dense {
+        if !has_dense {
+            return Err(crate::error::Error::input(
+                dir,
+                "this bake has no transport.npy (it was encoded only); drop --transport dense",
+            ));
+        }
+        let (shape, data) = crate::baked::read_npy_f32(&dir.join(TRANSPORT_FILE))?;
+        let (channels, n) = match shape.as_slice() {
+            [c, n, m] if n == m => (*c as usize, *n as usize),
+            _ => {
+                return Err(crate::error::Error::input(
+                    dir.join(TRANSPORT_FILE),
+                    format!("shape {shape:?} is not [channels, n, n]"),
+                ))
+            }
+        };
+        RadiosityRuntime::new(
+            gpu,
+            &set,
+            TransportSource::Dense(DenseTransport {
+                channels,
+                n,
+                data: &data,
+            }),
+            renderer,
+        )?
+    } else {
+        if !has_encoded {
+            return Err(crate::error::Error::input(
+                dir,
+                "this bake has no encoded transport (run the `encode` stage)",
+            ));
+        }
+        let encoded = crate::compress::stages::read_encoded(dir)?;
+        let path = opts
+            .decode
+            .unwrap_or_else(|| DecodePath::best(gpu, encoded.dense.encoding));
+        RadiosityRuntime::new(
+            gpu,
+            &set,
+            TransportSource::Compressed(&encoded, path),
+            renderer,
+        )?
+    };
+    Ok(Some((set, rt)))
 }

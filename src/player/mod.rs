@@ -33,6 +33,26 @@ impl Sun {
     }
 }
 
+/// Which transport the runtime gathers from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum TransportChoice {
+    /// The encoded transport when the bake has one, else the dense matrix.
+    #[default]
+    Auto,
+    /// The uncompressed `transport.npy` (reference).
+    Dense,
+    /// The `encode` stage's output.
+    Compressed,
+}
+
+/// How a bake is loaded.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct PlayerOptions {
+    pub transport: TransportChoice,
+    /// Force the BC decode path (None: hardware when the adapter has BC textures).
+    pub decode: Option<crate::gpu::compressed_gather::DecodePath>,
+}
+
 /// What every loaded bake can do each frame.
 pub enum Player {
     Mesh(Box<MeshPlayer>),
@@ -50,11 +70,17 @@ pub struct FrameTimes {
 
 impl Player {
     /// Load the bake at `dir` for a `width`×`height` target.
-    pub fn load(gpu: &Gpu, dir: &Path, width: u32, height: u32) -> Result<Player> {
+    pub fn load(
+        gpu: &Gpu,
+        dir: &Path,
+        opts: &PlayerOptions,
+        width: u32,
+        height: u32,
+    ) -> Result<Player> {
         let manifest = Manifest::read(dir)?;
         match manifest.pipeline.input.kind() {
             "scene" => Ok(Player::Mesh(Box::new(MeshPlayer::load(
-                gpu, dir, &manifest, width, height,
+                gpu, dir, &manifest, opts, width, height,
             )?))),
             other => Err(crate::error::Error::unsupported(
                 dir,

@@ -4,7 +4,7 @@ use relume::error::{Error, Result};
 use relume::gpu::blit::Blit;
 use relume::gpu::timing::PassTimer;
 use relume::gpu::{BackendChoice, Gpu};
-use relume::player::{Player, Sun};
+use relume::player::{Player, PlayerOptions, Sun};
 use relume::render::camera::Camera;
 use relume::render::mesh_reference::FrameSettings;
 use std::path::PathBuf;
@@ -69,6 +69,7 @@ struct App {
     camera: Option<Camera>,
     settings: FrameSettings,
     backend: Option<BackendChoice>,
+    options: PlayerOptions,
     running: Option<Running>,
     error: Option<Error>,
     dragging: Option<(f64, f64)>,
@@ -83,6 +84,7 @@ pub fn run(
     camera: Option<Camera>,
     settings: FrameSettings,
     backend: Option<BackendChoice>,
+    options: PlayerOptions,
 ) -> Result<()> {
     let event_loop = EventLoop::new().map_err(|e| {
         Error::Gpu(format!(
@@ -100,6 +102,7 @@ pub fn run(
         camera,
         settings,
         backend,
+        options,
         running: None,
         error: None,
         dragging: None,
@@ -158,7 +161,7 @@ impl App {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&gpu.device, &config);
-        let mut player = Player::load(&gpu, &self.dir, config.width, config.height)?;
+        let mut player = Player::load(&gpu, &self.dir, &self.options, config.width, config.height)?;
         player.set_sun(&gpu, self.sun_on.then_some(self.sun))?;
         let orbit = Orbit::from_camera(&self.camera.unwrap_or_else(|| player.default_camera()));
         let blit = Blit::new(&gpu, format)?;
