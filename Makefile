@@ -23,6 +23,8 @@ demo: build
 	$(BAKE) run pipelines/puget-sound.ron --out out/demo/puget-sound
 	$(BAKE) inspect out/demo/cornell
 	$(BAKE) inspect out/demo/puget-sound
+	$(BAKE) shadow pipelines/puget-sound.ron --sun-azimuth 300 --sun-elevation 10 \
+	    --out out/demo/puget-sound-shadow.png --shaded out/demo/puget-sound-relief.png
 	@echo
 	@echo "demo output is in out/demo/"
 

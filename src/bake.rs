@@ -47,7 +47,6 @@ pub struct StageTiming {
 
 /// Bake `pipeline` into `output`. On any error nothing is written and a previous bake at
 /// `output` is left as it was.
-#[allow(unreachable_code, unused_variables, unused_mut)] // until the first stage lands
 pub fn run_pipeline(
     pipeline: &Pipeline,
     output: &Path,
@@ -175,7 +174,6 @@ fn write_input(txn: &mut BakeTransaction, input: &LoadedInput) -> Result<StageRe
 /// Run one stage alone on an existing bake at `dir`, replacing it atomically. Stages that come
 /// after `stage` in pipeline order are dropped from the bake (their inputs changed), and the
 /// manifest's pipeline is updated so that it still describes how to reproduce the bake.
-#[allow(unreachable_code, unused_variables)] // until the first stage lands
 pub fn run_stage_on(dir: &Path, stage: Stage, progress: &dyn Progress) -> Result<BakeReport> {
     let manifest = Manifest::read(dir)?;
     let kind = stage.kind();

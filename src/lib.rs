@@ -14,6 +14,7 @@ pub mod load;
 pub mod pipeline;
 pub mod progress;
 pub mod scene;
+pub mod terrain;
 pub mod workspace;
 
 pub use error::{Error, Result};

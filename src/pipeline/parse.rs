@@ -16,7 +16,6 @@ pub const PLANNED_STAGES: &[&str] = &[
     "Transport",
     "Reorder",
     "Encode",
-    "MinmaxMipmap",
     "SoftShadow",
     "Freeform",
     "Theme",

@@ -26,44 +26,58 @@ pub trait StageRun {
 
 /// One stage of a pipeline with its knobs. Each variant's knobs live beside the stage's code.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Stage {}
+pub enum Stage {
+    /// Min/max mipmap of a height map (`minmax_mipmap.exr`).
+    MinmaxMipmap(crate::terrain::mipmap_stage::MinmaxMipmapKnobs),
+}
 
 /// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
 /// alone on a bake invalidates the stages that come after it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum StageKind {}
+pub enum StageKind {
+    MinmaxMipmap,
+}
 
 impl Stage {
     /// Which stage this is.
     pub fn kind(&self) -> StageKind {
-        match *self {}
+        match self {
+            Stage::MinmaxMipmap(_) => StageKind::MinmaxMipmap,
+        }
     }
 
     /// The stage's implementation.
     pub fn runner(&self) -> &dyn StageRun {
-        match *self {}
+        match self {
+            Stage::MinmaxMipmap(k) => k,
+        }
     }
 }
 
 impl StageKind {
     /// The name used in pipeline files and the manifest.
     pub fn name(self) -> &'static str {
-        match self {}
+        match self {
+            StageKind::MinmaxMipmap => "minmax_mipmap",
+        }
     }
 
     /// The input kind the stage works on (`"scene"` or `"heightmap"`).
     pub fn input_kind(self) -> &'static str {
-        match self {}
+        match self {
+            StageKind::MinmaxMipmap => "heightmap",
+        }
     }
 
     /// Stages that must have run before this one (in this pipeline or an earlier bake).
     pub fn requires(self) -> &'static [StageKind] {
-        match self {}
+        match self {
+            StageKind::MinmaxMipmap => &[],
+        }
     }
 }
 
 /// Check that every stage fits the input kind and comes after the stages it needs.
-#[allow(unreachable_code, unused_variables, unused_mut)] // until the first stage lands
 pub(super) fn check_order(path: &Path, pipeline: &Pipeline) -> Result<()> {
     let mut done: Vec<StageKind> = Vec::new();
     for stage in &pipeline.stages {

@@ -1,6 +1,7 @@
 //! `relume-bake`: the offline toolchain. Thin: parse arguments into a validated plan, call the
 //! library, show progress, print errors with their cause chain, exit with a code per cause.
 
+mod terrain;
 mod ui;
 
 use clap::{Args, Parser, Subcommand};
@@ -81,6 +82,11 @@ enum Command {
         /// Baked directory
         baked_dir: PathBuf,
     },
+    /// Hard relief shadows of a height map for one sun: shadow mask and shaded relief (PNG)
+    #[command(after_help = EXIT_CODES)]
+    Shadow(terrain::ShadowArgs),
+    /// Write a synthetic height map: stress maps (spikes, steps) and analytic shapes
+    Generate(terrain::GenerateArgs),
     /// Load a scene (.obj .gltf .glb) or height map (.png .jpg .exr .tif .raw) and summarise it
     Load {
         /// Scene or height-map file
@@ -240,6 +246,8 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             Ok(exit::OK)
         }
         Command::Inspect { baked_dir } => inspect(baked_dir, json),
+        Command::Shadow(a) => terrain::shadow(a, ui, cli.global.quiet, json),
+        Command::Generate(a) => terrain::generate_cmd(a, cli.global.quiet, json),
         Command::Load { file, knobs } => {
             let loaded = load_any(
                 file,
