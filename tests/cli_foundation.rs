@@ -82,10 +82,13 @@ fn run_writes_a_verified_bake_and_inspect_detects_damage() {
         ],
     );
     expect_code(&o, 0);
-    assert_eq!(list_files(&out), vec!["heightmap.exr", "manifest.ron"]);
+    assert_eq!(
+        list_files(&out),
+        vec!["heightmap.exr", "manifest.ron", "minmax_mipmap.exr"]
+    );
     assert_eq!(
         list_files(dir.path()).len(),
-        2,
+        3,
         "no temporary files left: {:?}",
         list_files(dir.path())
     );
@@ -216,7 +219,7 @@ fn plan_writes_nothing_and_run_respects_the_memory_budget() {
     let err = expect_code(&o, exit::LIMIT);
     assert!(err.contains("--max-memory") && err.contains("MiB"), "{err}");
     assert_eq!(std::fs::read(out.join("manifest.ron")).unwrap(), before);
-    assert_eq!(list_files(dir.path()).len(), 2);
+    assert_eq!(list_files(dir.path()).len(), 3); // heightmap, mipmap, manifest
 }
 
 /// One member of the bad-input corpus: the command, the exit code, what stderr must mention.

@@ -10,13 +10,7 @@ use std::path::Path;
 
 /// Stage names that belong to relume's design but are not implemented by this version. A
 /// pipeline naming one is rejected as "not yet supported", never silently ignored.
-pub const PLANNED_STAGES: &[&str] = &[
-    "MinmaxMipmap",
-    "SoftShadow",
-    "Freeform",
-    "Theme",
-    "Atmosphere",
-];
+pub const PLANNED_STAGES: &[&str] = &["SoftShadow", "Freeform", "Theme", "Atmosphere"];
 
 /// Read and validate a pipeline file. Input paths are resolved against the file's directory.
 pub fn parse_pipeline(path: &Path) -> Result<Pipeline> {

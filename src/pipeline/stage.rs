@@ -37,6 +37,8 @@ pub enum Stage {
     Reorder(crate::compress::stages::ReorderKnobs),
     /// Split, log map and block-compress the transport (src/compress/).
     Encode(crate::compress::stages::EncodeKnobs),
+    /// Min/max mipmap of a height map (`minmax_mipmap.exr`).
+    MinmaxMipmap(crate::terrain::mipmap_stage::MinmaxMipmapKnobs),
 }
 
 /// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
@@ -48,6 +50,7 @@ pub enum StageKind {
     Transport,
     Reorder,
     Encode,
+    MinmaxMipmap,
 }
 
 impl Stage {
@@ -59,6 +62,7 @@ impl Stage {
             Stage::Transport(_) => StageKind::Transport,
             Stage::Reorder(_) => StageKind::Reorder,
             Stage::Encode(_) => StageKind::Encode,
+            Stage::MinmaxMipmap(_) => StageKind::MinmaxMipmap,
         }
     }
 
@@ -70,6 +74,7 @@ impl Stage {
             Stage::Transport(k) => k,
             Stage::Reorder(k) => k,
             Stage::Encode(k) => k,
+            Stage::MinmaxMipmap(k) => k,
         }
     }
 }
@@ -83,6 +88,7 @@ impl StageKind {
             StageKind::Transport => "transport",
             StageKind::Reorder => "reorder",
             StageKind::Encode => "encode",
+            StageKind::MinmaxMipmap => "minmax_mipmap",
         }
     }
 
@@ -91,6 +97,7 @@ impl StageKind {
         match self {
             StageKind::Voxelize | StageKind::FormFactors | StageKind::Transport => "scene",
             StageKind::Reorder | StageKind::Encode => "scene",
+            StageKind::MinmaxMipmap => "heightmap",
         }
     }
 
@@ -101,6 +108,7 @@ impl StageKind {
             StageKind::FormFactors => &[StageKind::Voxelize],
             StageKind::Transport => &[StageKind::Voxelize, StageKind::FormFactors],
             StageKind::Reorder | StageKind::Encode => &[StageKind::Transport],
+            StageKind::MinmaxMipmap => &[],
         }
     }
 }

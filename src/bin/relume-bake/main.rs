@@ -3,6 +3,7 @@
 
 mod compress;
 mod radiosity;
+mod terrain;
 mod ui;
 
 use clap::{Args, Parser, Subcommand};
@@ -85,6 +86,11 @@ enum Command {
     },
     #[command(flatten)]
     Radiosity(radiosity::Command),
+    /// Hard relief shadows of a height map for one sun: shadow mask and shaded relief (PNG)
+    #[command(after_help = EXIT_CODES)]
+    Shadow(terrain::ShadowArgs),
+    /// Write a synthetic height map: stress maps (spikes, steps) and analytic shapes
+    Generate(terrain::GenerateArgs),
     /// Load a scene (.obj .gltf .glb) or height map (.png .jpg .exr .tif .raw) and summarise it
     Load {
         /// Scene or height-map file
@@ -248,6 +254,8 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         Command::Inspect { baked_dir } => inspect(baked_dir, json),
         Command::Radiosity(c) => radiosity::run(c, json, cli.global.quiet, ui),
         Command::Compress(c) => compress::run(c, ui, json, cli.global.quiet),
+        Command::Shadow(a) => terrain::shadow(a, ui, cli.global.quiet, json),
+        Command::Generate(a) => terrain::generate_cmd(a, cli.global.quiet, json),
         Command::Load { file, knobs } => {
             let loaded = load_any(
                 file,

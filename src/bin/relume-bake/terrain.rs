@@ -1,0 +1,246 @@
+//! Terrain subcommands: `shadow` (hard relief shadows), `generate` (synthetic height maps) and
+//! `softshadow` (sun-disc soft shadows). Thin: load, call the library, write images atomically.
+
+use crate::ui::Ui;
+use clap::{Args, ValueEnum};
+use relume::error::exit;
+use relume::heightmap::{load_heightmap, HeightMap, HeightMapOptions};
+use relume::progress::Progress;
+use relume::terrain::generate::{generate, quantise_u16, Shape};
+use relume::terrain::images::{self, check_extension};
+use relume::terrain::relief::{self, HardMethod};
+use relume::terrain::Sun;
+use relume::{Error, Result};
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+const SUN_HELP: &str = "\
+Sun convention: azimuth in degrees clockwise from north, where north is up the image (toward
+row 0) and east is toward the last column: 0 = sun in the north, 90 = east, 180 = south,
+270 = west. Elevation in degrees above the horizon (0 = on the horizon, 90 = zenith).
+Input: a height map (.png .jpg .exr .tif .raw) or a pipeline file (.ron), whose input and
+its knobs (cell size, height scale, no-data policy) are used.";
+
+/// Where the height map comes from and how to scale it.
+#[derive(Args, Clone)]
+pub struct MapArgs {
+    /// Height map (.png .jpg .exr .tif .raw) or pipeline file (.ron)
+    pub input: PathBuf,
+    /// Metres per texel (overrides the world file / GeoTIFF tags / pipeline)
+    #[arg(long, value_name = "M")]
+    pub cell_size: Option<f64>,
+    /// Metres per file unit (overrides the pipeline)
+    #[arg(long, value_name = "S")]
+    pub height_scale: Option<f64>,
+}
+
+/// The sun's direction.
+#[derive(Args, Clone)]
+pub struct SunArgs {
+    /// Degrees clockwise from north (0 = north = up the image, 90 = east)
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub sun_azimuth: f64,
+    /// Degrees above the horizon
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub sun_elevation: f64,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum HardMethodArg {
+    /// Every texel on the track (the reference)
+    Exact,
+    /// Over the min/max mipmap (same answer, faster)
+    Accelerated,
+}
+
+#[derive(Args)]
+#[command(after_help = SUN_HELP)]
+pub struct ShadowArgs {
+    #[command(flatten)]
+    pub map: MapArgs,
+    #[command(flatten)]
+    pub sun: SunArgs,
+    /// Traversal method
+    #[arg(long, value_enum, default_value_t = HardMethodArg::Accelerated)]
+    pub method: HardMethodArg,
+    /// Shadow mask to write (.png: white = lit, black = shadow)
+    #[arg(long, value_name = "MASK.png")]
+    pub out: PathBuf,
+    /// Also write a shaded relief (.png, sRGB): Lambert × k_shadow inside shadows
+    #[arg(long, value_name = "RELIEF.png")]
+    pub shaded: Option<PathBuf>,
+    /// Shadow brightness with the sun on the horizon
+    #[arg(long, default_value_t = 0.2, value_name = "K")]
+    pub k_dark: f64,
+    /// Shadow brightness with the sun at the zenith
+    #[arg(long, default_value_t = 0.6, value_name = "K")]
+    pub k_bright: f64,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum ShapeArg {
+    /// Five thin tall cones (the seed's stress map)
+    Spikes,
+    /// Sharp terraces (the seed's stress map)
+    Steps,
+    Flat,
+    /// A north-south wall
+    Wall,
+    Cone,
+    Hemisphere,
+    /// A hemispherical bowl
+    Crater,
+}
+
+#[derive(Args)]
+pub struct GenerateArgs {
+    /// Which map
+    #[arg(value_enum)]
+    pub shape: ShapeArg,
+    /// Width and height in texels (cell size 1 m; feature heights scale with it)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub size: u32,
+    /// Output: .exr (f32 metres) or .png (16-bit; prints the height scale to load it with)
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}
+
+/// Load the input of a terrain command: a height map, or a pipeline's height-map input.
+pub fn load_map(args: &MapArgs) -> Result<HeightMap> {
+    let is_pipeline = args
+        .input
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+    let mut opts = if is_pipeline {
+        let p = relume::pipeline::parse_pipeline(&args.input)?;
+        match &p.input {
+            relume::pipeline::Input::HeightMap(h) => (h.path.clone(), h.options()),
+            relume::pipeline::Input::Scene(_) => {
+                return Err(Error::input(
+                    &args.input,
+                    "this pipeline's input is a scene; terrain commands need a height map",
+                ))
+            }
+        }
+    } else {
+        (args.input.clone(), HeightMapOptions::default())
+    };
+    if let Some(c) = args.cell_size {
+        opts.1.cell_size = Some([c, c]);
+    }
+    if let Some(s) = args.height_scale {
+        opts.1.height_scale = Some(s);
+    }
+    let (map, _) = load_heightmap(&opts.0, &opts.1)?;
+    Ok(map)
+}
+
+fn print_json(v: &serde_json::Value) {
+    println!("{}", serde_json::to_string_pretty(v).expect("json"));
+}
+
+/// `relume-bake shadow`.
+pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
+    let sun = Sun::new(args.sun.sun_azimuth, args.sun.sun_elevation)?;
+    relief::check_k(args.k_dark, args.k_bright)?;
+    check_extension(&args.out, &["png"])?;
+    if let Some(s) = &args.shaded {
+        check_extension(s, &["png"])?;
+    }
+    ui.begin("load", 0);
+    let map = load_map(&args.map)?;
+    ui.finish();
+    let method = match args.method {
+        HardMethodArg::Exact => HardMethod::Exact,
+        HardMethodArg::Accelerated => HardMethod::Accelerated,
+    };
+    let t0 = Instant::now();
+    let mask = relief::shadow_mask(&map, &sun, method, None, ui);
+    let seconds = t0.elapsed().as_secs_f64();
+    let shadowed = mask.iter().filter(|s| **s).count();
+    let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
+    images::write_png_gray8(&args.out, map.width, map.height, pixels)?;
+    if let Some(path) = &args.shaded {
+        let shadow: Vec<f32> = mask.iter().map(|&s| s as u8 as f32).collect();
+        let relief = relief::shaded_relief(&map, &sun, &shadow, args.k_dark, args.k_bright);
+        let px = relief.into_iter().map(images::linear_to_srgb8).collect();
+        images::write_png_gray8(path, map.width, map.height, px)?;
+    }
+    let fraction = shadowed as f64 / mask.len() as f64;
+    let mpix = mask.len() as f64 / seconds.max(1e-9) / 1e6;
+    if json {
+        print_json(&json!({
+            "input": args.map.input.display().to_string(),
+            "width": map.width, "height": map.height,
+            "cell_size": map.cell_size, "height_scale": map.height_scale,
+            "sun_azimuth": sun.azimuth_deg, "sun_elevation": sun.elevation_deg,
+            "method": match method { HardMethod::Exact => "exact", HardMethod::Accelerated => "accelerated" },
+            "shadowed_fraction": fraction,
+            "seconds": seconds, "mpixels_per_second": mpix,
+            "out": args.out.display().to_string(),
+            "shaded": args.shaded.as_ref().map(|p| p.display().to_string()),
+        }));
+    } else if !quiet {
+        eprintln!(
+            "{}x{}: {:.1} % in shadow, {:.3} s ({:.1} Mpixel/s) → {}",
+            map.width,
+            map.height,
+            100.0 * fraction,
+            seconds,
+            mpix,
+            args.out.display()
+        );
+    }
+    Ok(exit::OK)
+}
+
+/// `relume-bake generate`.
+pub fn generate_cmd(args: &GenerateArgs, quiet: bool, json: bool) -> Result<i32> {
+    check_extension(&args.out, &["png", "exr"])?;
+    let shape = match args.shape {
+        ShapeArg::Spikes => Shape::Spikes,
+        ShapeArg::Steps => Shape::Steps,
+        ShapeArg::Flat => Shape::Flat,
+        ShapeArg::Wall => Shape::Wall,
+        ShapeArg::Cone => Shape::Cone,
+        ShapeArg::Hemisphere => Shape::Hemisphere,
+        ShapeArg::Crater => Shape::Crater,
+    };
+    let n = args.size as usize;
+    relume::limits::check_memory(
+        "this height map",
+        (n * n * 8) as u64,
+        relume::limits::default_max_memory(),
+    )?;
+    let map = generate(shape, n);
+    let (lo, hi) = map.min_max();
+    let (scale, offset) = if images::is_exr(&args.out) {
+        images::write_exr_gray(&args.out, n, n, &map.heights)?;
+        (1.0, 0.0)
+    } else {
+        let (values, scale, offset) = quantise_u16(&map);
+        images::write_png_gray16(&args.out, n, n, values)?;
+        (scale, offset)
+    };
+    if json {
+        print_json(&json!({
+            "shape": shape.name(), "size": n, "out": args.out.display().to_string(),
+            "min_height": lo, "max_height": hi, "cell_size": 1.0,
+            "height_scale": scale, "height_offset": offset,
+        }));
+    } else if !quiet {
+        eprintln!(
+            "{} {n}x{n} (cell 1 m, heights {lo} .. {hi} m) → {}{}",
+            shape.name(),
+            args.out.display(),
+            if images::is_exr(&args.out) {
+                String::new()
+            } else {
+                format!(" (16-bit: load with --height-scale {scale}; offset {offset} m dropped)")
+            }
+        );
+    }
+    Ok(exit::OK)
+}

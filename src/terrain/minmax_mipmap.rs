@@ -1,0 +1,319 @@
+//! The min/max mipmap (DESIGN.md §4; seed 000's {h_max, h_min} mipmap): the acceleration
+//! structure of the accelerated hard-shadow traversal and of the soft-shadow methods.
+//!
+//! Level 0 is half the map's size (rounded up): texel (bx, by) bounds block
+//! [2bx, 2bx+2) × [2by, 2by+2) of the height map. Level L halves level L−1 (rounded up) with 2×2
+//! max/min reductions, so a level-L texel bounds the block of side B_L = 2^(L+1) texels starting
+//! at (bx·B_L, by·B_L). Levels stop before 1×1 (a map whose level 0 would be 1×1 has no levels).
+//! Odd and non-power-of-two sizes: edge blocks reduce the children (and texels) that exist.
+//!
+//! **Bounds.** Level 0 stores the max and min of the texels in the block *plus a one-texel
+//! border* (the 4×4 texels [2bx−1, 2bx+2] × [2by−1, 2by+2], clamped to the map) — the footprint
+//! of the seed's 3×3 pattern of bilinear samples, with texel values instead of averages. Why
+//! this is conservative for every value the exact traversal samples in the block: a sample of
+//! texel T is taken at a point Q clamped into T's square, and [`sample_bilinear`] clamps its
+//! result to the range of the four texels of Q's bilinear cell; for Q in T's square those four
+//! texels lie within one texel of T (border-clamped), hence inside the block's bordered
+//! footprint. So every sample h satisfies min ≤ h ≤ max, exactly, in floating point (no
+//! rounding is involved in a min/max of f32 values); `tests/terrain_mipmap.rs` checks it with
+//! proptest. The bound is looser than the exact range of bilinear values (which would need
+//! averages and outward rounding to stay provable) only next to a block's border.
+//!
+//! **Flat layout** (what the GPU uploads): `data` holds 2 f32 per texel, `max` then `min`, levels
+//! one after another; texel (bx, by) of level L is at `2 · (levels[L].offset + by · levels[L].width + bx)`.
+//!
+//! [`sample_bilinear`]: super::exact_traversal::sample_bilinear
+
+use crate::error::Result;
+use crate::heightmap::HeightMap;
+use rayon::prelude::*;
+use std::path::Path;
+
+/// The size and place of one level in [`MinMaxMipmap::data`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MipLevel {
+    pub width: usize,
+    pub height: usize,
+    /// Index of the level's first texel (in texels, not floats).
+    pub offset: usize,
+}
+
+/// Min/max mipmap of a height map.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MinMaxMipmap {
+    /// Size of the height map it was built from.
+    pub map_width: usize,
+    pub map_height: usize,
+    pub levels: Vec<MipLevel>,
+    /// (max, min) pairs, level after level, row-major.
+    pub data: Vec<f32>,
+    /// The largest height of the map (the maximum over the coarsest level).
+    pub max_height: f32,
+}
+
+/// The level sizes for a map: ceil(W/2) × ceil(H/2), then ceil halving, stopping before 1×1
+/// (level 0 always exists, 1×1 for maps of at most 2×2).
+pub fn level_sizes(width: usize, height: usize) -> Vec<(usize, usize)> {
+    let (mut w, mut h) = (width.div_ceil(2), height.div_ceil(2));
+    let mut out = vec![(w, h)];
+    loop {
+        w = w.div_ceil(2);
+        h = h.div_ceil(2);
+        if w == 1 && h == 1 {
+            return out;
+        }
+        out.push((w, h));
+    }
+}
+
+impl MinMaxMipmap {
+    /// Build the mipmap of `map` (parallel over rows; the result does not depend on threads).
+    pub fn build(map: &HeightMap) -> MinMaxMipmap {
+        let sizes = level_sizes(map.width, map.height);
+        let mut levels = Vec::with_capacity(sizes.len());
+        let mut offset = 0;
+        for &(width, height) in &sizes {
+            levels.push(MipLevel {
+                width,
+                height,
+                offset,
+            });
+            offset += width * height;
+        }
+        let mut data = vec![0.0f32; 2 * offset];
+        if let Some(l0) = levels.first() {
+            let (w, h) = (map.width, map.height);
+            let hs = &map.heights;
+            data[..2 * l0.width * l0.height]
+                .par_chunks_mut(2 * l0.width)
+                .enumerate()
+                .for_each(|(by, row)| {
+                    let y0 = (2 * by).saturating_sub(1);
+                    let y1 = (2 * by + 2).min(h - 1);
+                    for bx in 0..l0.width {
+                        let x0 = (2 * bx).saturating_sub(1);
+                        let x1 = (2 * bx + 2).min(w - 1);
+                        let (mut hi, mut lo) = (f32::NEG_INFINITY, f32::INFINITY);
+                        for y in y0..=y1 {
+                            for &v in &hs[y * w + x0..=y * w + x1] {
+                                hi = hi.max(v);
+                                lo = lo.min(v);
+                            }
+                        }
+                        row[2 * bx] = hi;
+                        row[2 * bx + 1] = lo;
+                    }
+                });
+        }
+        for l in 1..levels.len() {
+            let (prev, cur) = (levels[l - 1], levels[l]);
+            let (done, rest) = data.split_at_mut(2 * cur.offset);
+            let src = &done[2 * prev.offset..];
+            rest[..2 * cur.width * cur.height]
+                .par_chunks_mut(2 * cur.width)
+                .enumerate()
+                .for_each(|(by, row)| {
+                    for bx in 0..cur.width {
+                        let (mut hi, mut lo) = (f32::NEG_INFINITY, f32::INFINITY);
+                        for y in 2 * by..(2 * by + 2).min(prev.height) {
+                            for x in 2 * bx..(2 * bx + 2).min(prev.width) {
+                                let i = 2 * (y * prev.width + x);
+                                hi = hi.max(src[i]);
+                                lo = lo.min(src[i + 1]);
+                            }
+                        }
+                        row[2 * bx] = hi;
+                        row[2 * bx + 1] = lo;
+                    }
+                });
+        }
+        let max_height = top_max(&levels, &data);
+        MinMaxMipmap {
+            map_width: map.width,
+            map_height: map.height,
+            levels,
+            data,
+            max_height,
+        }
+    }
+
+    /// (max, min) of texel (bx, by) of `level`.
+    #[inline]
+    pub fn texel(&self, level: usize, bx: usize, by: usize) -> (f32, f32) {
+        let l = &self.levels[level];
+        let i = 2 * (l.offset + by * l.width + bx);
+        (self.data[i], self.data[i + 1])
+    }
+
+    /// Side of the block of height-map texels a texel of `level` bounds (without the border).
+    pub fn block_size(level: usize) -> usize {
+        2 << level
+    }
+
+    /// Bytes of the texel data (f32 pairs).
+    pub fn bytes(&self) -> usize {
+        self.data.len() * 4
+    }
+
+    /// Write as a multi-part OpenEXR file (docs/baked-format.md): one part per level named
+    /// `level0`, `level1`, ..., each with f32 channels `max` and `min`, ZIP compression, and the
+    /// height map's size in the custom attribute `relumeMapSize` (v2i) of every part.
+    /// Deterministic.
+    pub fn write_exr(&self, path: &Path) -> Result<()> {
+        use exr::meta::attribute::AttributeValue;
+        use exr::prelude::*;
+        let encoding = Encoding {
+            compression: Compression::ZIP16,
+            blocks: Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        };
+        let mut layers: SmallVec<[Layer<AnyChannels<FlatSamples>>; 2]> = SmallVec::new();
+        for (i, l) in self.levels.iter().enumerate() {
+            let n = l.width * l.height;
+            let pairs = &self.data[2 * l.offset..2 * (l.offset + n)];
+            let max: Vec<f32> = pairs.iter().step_by(2).copied().collect();
+            let min: Vec<f32> = pairs.iter().skip(1).step_by(2).copied().collect();
+            let channels = AnyChannels::sort(SmallVec::from_vec(vec![
+                AnyChannel::new("max", FlatSamples::F32(max)),
+                AnyChannel::new("min", FlatSamples::F32(min)),
+            ]));
+            let mut attributes = LayerAttributes::named(format!("level{i}").as_str());
+            attributes.other.insert(
+                Text::from("relumeMapSize"),
+                AttributeValue::IntVec2(Vec2(self.map_width as i32, self.map_height as i32)),
+            );
+            layers.push(Layer::new(
+                (l.width, l.height),
+                attributes,
+                encoding,
+                channels,
+            ));
+        }
+        let attributes = ImageAttributes::new(IntegerBounds::from_dimensions((
+            self.levels[0].width,
+            self.levels[0].height,
+        )));
+        Image::from_layers(attributes, layers)
+            .write()
+            .non_parallel()
+            .to_file(path)
+            .map_err(|e| crate::baked::exr_io::exr_error(path, "cannot write EXR", e))
+    }
+
+    /// Read a file written by [`MinMaxMipmap::write_exr`], checking its structure.
+    pub fn read_exr(path: &Path) -> Result<MinMaxMipmap> {
+        use exr::meta::attribute::AttributeValue;
+        use exr::prelude::*;
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .all_layers()
+            .all_attributes()
+            .from_file(path)
+            .map_err(|e| crate::baked::exr_io::exr_error(path, "cannot read EXR", e))?;
+        let bad = |m: String| crate::error::Error::input(path, m);
+        let first = image.layer_data.first().map(|l| &l.attributes.other);
+        let (mw, mh) = match first.and_then(|o| o.get(&Text::from("relumeMapSize"))) {
+            Some(AttributeValue::IntVec2(Vec2(w, h))) if *w > 0 && *h > 0 => {
+                (*w as usize, *h as usize)
+            }
+            _ => {
+                return Err(bad(
+                    "not a relume min/max mipmap: no `relumeMapSize` attribute".into(),
+                ))
+            }
+        };
+        let sizes = level_sizes(mw, mh);
+        if image.layer_data.len() != sizes.len() {
+            return Err(bad(format!(
+                "a {mw}x{mh} map has {} mipmap levels, the file has {} parts",
+                sizes.len(),
+                image.layer_data.len()
+            )));
+        }
+        let mut levels = Vec::new();
+        let mut data = Vec::new();
+        for (i, (layer, &(w, h))) in image.layer_data.iter().zip(&sizes).enumerate() {
+            let name = layer.attributes.layer_name.as_ref().map(|t| t.to_string());
+            if name.as_deref() != Some(format!("level{i}").as_str())
+                || layer.size.width() != w
+                || layer.size.height() != h
+            {
+                return Err(bad(format!(
+                    "part {i} should be `level{i}` of {w}x{h}, found {:?} of {}x{}",
+                    name,
+                    layer.size.width(),
+                    layer.size.height()
+                )));
+            }
+            let channel = |n: &str| -> crate::error::Result<Vec<f32>> {
+                let c = layer
+                    .channel_data
+                    .list
+                    .iter()
+                    .find(|c| c.name.to_string() == n)
+                    .ok_or_else(|| bad(format!("part level{i} has no `{n}` channel")))?;
+                match &c.sample_data {
+                    FlatSamples::F32(v) => Ok(v.clone()),
+                    _ => Err(bad(format!("channel {n} of level{i} is not f32"))),
+                }
+            };
+            let (max, min) = (channel("max")?, channel("min")?);
+            levels.push(MipLevel {
+                width: w,
+                height: h,
+                offset: data.len() / 2,
+            });
+            for (a, b) in max.into_iter().zip(min) {
+                data.push(a);
+                data.push(b);
+            }
+        }
+        let max_height = top_max(&levels, &data);
+        Ok(MinMaxMipmap {
+            map_width: mw,
+            map_height: mh,
+            levels,
+            data,
+            max_height,
+        })
+    }
+}
+
+fn top_max(levels: &[MipLevel], data: &[f32]) -> f32 {
+    let top = levels.last().expect("level 0 always exists");
+    data[2 * top.offset..2 * (top.offset + top.width * top.height)]
+        .iter()
+        .step_by(2)
+        .copied()
+        .fold(f32::NEG_INFINITY, f32::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn level_sizes_round_up_and_stop_before_one_by_one() {
+        assert_eq!(level_sizes(8, 8), vec![(4, 4), (2, 2)]);
+        assert_eq!(level_sizes(2, 2), vec![(1, 1)]);
+        assert_eq!(level_sizes(1, 1), vec![(1, 1)]);
+        assert_eq!(level_sizes(5, 1), vec![(3, 1), (2, 1)]);
+        assert_eq!(level_sizes(1197, 643).len(), 10);
+        assert_eq!(level_sizes(4096, 4096).len(), 11);
+    }
+
+    #[test]
+    fn level_zero_includes_a_one_texel_border() {
+        // A single peak at (2, 0) is inside block 1 and in the border of block 0.
+        let mut h = vec![0.0f32; 6 * 2];
+        h[2] = 5.0;
+        let m = MinMaxMipmap::build(&HeightMap::new(6, 2, h, [1.0, 1.0]));
+        assert_eq!(m.levels.len(), 2);
+        assert_eq!(m.texel(0, 0, 0), (5.0, 0.0));
+        assert_eq!(m.texel(0, 1, 0), (5.0, 0.0));
+        assert_eq!(m.texel(0, 2, 0), (0.0, 0.0));
+        assert_eq!(m.texel(1, 1, 0), (0.0, 0.0));
+    }
+}

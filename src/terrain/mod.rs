@@ -1,0 +1,24 @@
+//! Terrain: relief shadows on height maps (DESIGN.md §4, §5).
+//!
+//! - [`sun`]: the sun direction and its track in texel space (the constants every kernel uses);
+//! - [`exact_traversal`]: hard shadows by visiting every texel on the track (algorithm A1, the reference);
+//! - [`minmax_mipmap`]: the min/max mipmap (the `minmax_mipmap` pipeline stage);
+//! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
+//! - [`relief`]: whole-image shadow masks and shaded relief;
+//! - [`generate`]: synthetic height maps (stress maps and analytic shapes);
+//! - [`images`]: writing masks and reliefs (PNG/EXR) atomically.
+//!
+//! Per-pixel kernels are plain loops over flat arrays (no recursion, no allocation) so that
+//! the GPU player can port them line by line to WGSL.
+
+pub mod accelerated_traversal;
+pub mod exact_traversal;
+pub mod generate;
+pub mod images;
+pub mod minmax_mipmap;
+pub mod mipmap_stage;
+pub mod relief;
+pub mod sun;
+
+pub use minmax_mipmap::MinMaxMipmap;
+pub use sun::{Sun, Track, TrackKind};
