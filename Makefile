@@ -16,12 +16,14 @@ all: build
 build:
 	$(CARGO) build --release --locked
 
-## The main job on the bundled default: bake the Cornell box and Puget Sound.
+## The main job on the bundled default: bake the Cornell box (voxelize → form factors → transport)
+## and Puget Sound.
 demo: build
 	@mkdir -p out/demo
 	$(BAKE) run pipelines/cornell.ron --out out/demo/cornell
 	$(BAKE) run pipelines/puget-sound.ron --out out/demo/puget-sound
 	$(BAKE) inspect out/demo/cornell
+	$(BAKE) export out/demo/cornell patches --out out/demo/cornell-patches.json
 	$(BAKE) inspect out/demo/puget-sound
 	@echo
 	@echo "demo output is in out/demo/"

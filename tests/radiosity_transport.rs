@@ -14,7 +14,10 @@ const BIG: u64 = 1 << 40;
 
 /// Patches and hemisphere form factors (512 rays: every F_ij = hits/512 is exact in f32, so
 /// closed-box rows sum to exactly 1).
-fn bake(scene: &Scene, resolution: Resolution) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<f32>, usize) {
+/// (albedo, emission, F, n).
+type Baked = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<f32>, usize);
+
+fn bake(scene: &Scene, resolution: Resolution) -> Baked {
     let set = voxelize(
         scene,
         &VoxelizeParams {
@@ -88,6 +91,7 @@ fn furnace_gives_the_geometric_series() {
 }
 
 #[test]
+#[allow(clippy::needless_range_loop)] // indices name matrix entries
 fn one_bounce_is_m_and_more_bounces_converge_to_infinity() {
     let scene = relume::scene::load_scene(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -65,13 +65,13 @@ fn cornell_light_in_the_ceiling_plane_neither_doubles_area_nor_loses_emission() 
         );
         assert!((set.stats.covered_area - light_area).abs() < 1e-6);
         // Emitted power (Σ A·L) equals the light's, per channel.
-        for c in 0..3 {
+        for (c, &l) in radiance.iter().enumerate() {
             let power: f64 = set
                 .patches
                 .iter()
                 .map(|p| p.area as f64 * p.emission[c] as f64)
                 .sum();
-            let want = light_area * radiance[c] as f64;
+            let want = light_area * l as f64;
             assert!(
                 (power - want).abs() < 1e-5 * want,
                 "{target} channel {c}: {power} vs {want}"
