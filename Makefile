@@ -18,12 +18,14 @@ all: build
 build:
 	$(CARGO) build --release --locked
 
-## The main job on the bundled default: bake the Cornell box and Puget Sound.
+## The main job on the bundled default: bake the Cornell box (voxelize → form factors → transport)
+## and Puget Sound.
 demo: build
 	@mkdir -p out/demo
 	$(BAKE) run pipelines/cornell.ron --out out/demo/cornell
 	$(BAKE) run pipelines/puget-sound.ron --out out/demo/puget-sound
 	$(BAKE) inspect out/demo/cornell
+	$(BAKE) export out/demo/cornell patches --out out/demo/cornell-patches.json
 	$(BAKE) inspect out/demo/puget-sound
 	$(BAKE) shadow pipelines/puget-sound.ron --sun-azimuth 300 --sun-elevation 10 \
 	    --out out/demo/puget-sound-shadow.png --shaded out/demo/puget-sound-relief.png

@@ -75,7 +75,7 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     let mut timer = relume::gpu::timing::PassTimer::new(&gpu, 48);
     let set: PatchSet = relume::baked::read_postcard(&dir.join("patches.bin")).unwrap();
     let lights = Vec::new(); // the Cornell box is lit by its emitter only
-    let e = patch_exitance(&set, &lights, &s, &|_, _, _, _| true);
+    let e = patch_exitance(&set, &lights, &s, &|_, _, _, _, _| true);
     let n = set.patches.len();
     let flat = |v: &[f32]| {
         v.chunks_exact(4)

@@ -173,6 +173,28 @@ pub fn distance_to_polygon(p: DVec3, poly: &[DVec3], n: DVec3) -> f64 {
     (closest_point_on_polygon(p, poly, n) - p).length()
 }
 
+/// Form factor from a differential area at `x` with unit normal `n` to the triangle `tri`
+/// (unit normal `tn`), unoccluded: Lambert's contour formula
+/// `F = 1/(2π) Σ_k β_k n·Γ_k` over the part of the triangle in front of `x` (the triangle is
+/// clipped to the half-space `n·(y − x) ≥ 0`; a triangle facing away from `x` gives 0).
+pub fn point_to_triangle(x: DVec3, n: DVec3, tri: [DVec3; 3], tn: DVec3) -> f64 {
+    if tn.dot(x - tri[0]) <= 0.0 {
+        return 0.0;
+    }
+    let front = split(&tri, n, n.dot(x)).1;
+    let mut s = 0.0;
+    for k in 0..front.len() {
+        let a = front[k] - x;
+        let b = front[(k + 1) % front.len()] - x;
+        let c = a.cross(b);
+        let len = c.length();
+        if len > 0.0 {
+            s += len.atan2(a.dot(b)) * n.dot(c / len);
+        }
+    }
+    (s / std::f64::consts::TAU).abs()
+}
+
 /// A point drawn uniformly from the triangle `a b c` with `u, v` in [0, 1).
 pub fn point_in_triangle(a: DVec3, b: DVec3, c: DVec3, u: f64, v: f64) -> DVec3 {
     let su = u.sqrt();
@@ -239,6 +261,30 @@ impl AreaSampler {
         self.triangles.is_empty()
     }
 
+    /// The fan triangles (a, b, c, unit normal).
+    pub fn triangles(&self) -> &[(DVec3, DVec3, DVec3, DVec3)] {
+        &self.triangles
+    }
+
+    /// The point and normal for a point `(u, v)` of the unit square, keeping its stratification:
+    /// `u` chooses the fan triangle by area and, rescaled within that triangle's share, is the
+    /// first coordinate inside it.
+    pub fn sample_square(&self, u: f64, v: f64) -> (DVec3, DVec3) {
+        let k = self
+            .cumulative
+            .partition_point(|&c| c <= u)
+            .min(self.triangles.len() - 1);
+        let lo = if k == 0 { 0.0 } else { self.cumulative[k - 1] };
+        let hi = self.cumulative[k];
+        let w = if hi > lo {
+            ((u - lo) / (hi - lo)).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        let (a, b, c, n) = self.triangles[k];
+        (point_in_triangle(a, b, c, w, v), n)
+    }
+
     /// The point and normal at `select` (chooses the triangle by area) and `u, v` (inside it).
     pub fn sample(&self, select: f64, u: f64, v: f64) -> (DVec3, DVec3) {
         let k = self
@@ -289,6 +335,20 @@ impl Rng {
             p.swap(i, self.below(i + 1));
         }
         p
+    }
+
+    /// `n` points of the unit square, jittered-stratified: the cells of a `g × g` grid
+    /// (`g = ⌈√n⌉`) in random order, the first `n` of them, one random point in each.
+    pub fn jittered(&mut self, n: usize) -> Vec<(f64, f64)> {
+        let g = ((n as f64).sqrt().ceil() as usize).max(1);
+        let cells = self.permutation(g * g);
+        cells[..n]
+            .iter()
+            .map(|&c| {
+                let (cx, cy) = ((c as usize % g) as f64, (c as usize / g) as f64);
+                ((cx + self.f64()) / g as f64, (cy + self.f64()) / g as f64)
+            })
+            .collect()
     }
 
     /// `n` Latin-hypercube values in [0, 1): one in each stratum `[k/n, (k+1)/n)`, shuffled.

@@ -1,6 +1,7 @@
 //! Which patch a point on a surface belongs to: the patch of the point's voxel and its
 //! triangle's dominant axis whose pieces are nearest to the point (searching the 26 neighbouring
-//! voxels when the point sits on a voxel boundary). A point under a coplanar cover (the Cornell
+//! voxels when the point sits on a voxel boundary). When the voxel holds exactly one patch of that
+//! orientation, that patch is the answer without a distance test. A point under a coplanar cover (the Cornell
 //! ceiling above the light) lies on the cover's piece, so it finds the cover's patch.
 
 use super::geometry::{self, dominant_axis};
@@ -25,11 +26,17 @@ pub struct PatchLocator {
     pieces: Vec<(Vec<DVec3>, DVec3)>,
     /// Dominant axis of each scene triangle.
     triangle_axis: Vec<u8>,
+    /// Dense (first patch, count) per group key when the grid is small enough, else empty (then
+    /// a binary search over `keys`).
+    table: Vec<(u32, u32)>,
 }
+
+/// Largest grid (voxels × 8 axis slots) that gets a dense lookup table.
+const DENSE_TABLE: u64 = 1 << 24;
 
 impl PatchLocator {
     pub fn new(set: &PatchSet, scene: &Scene) -> Self {
-        let keys = set
+        let keys: Vec<u64> = set
             .patches
             .iter()
             .map(|p| group_key(p.voxel, p.axis, set.dims))
@@ -55,12 +62,25 @@ impl PatchLocator {
                 dominant_axis((b - a).cross(c - a))
             })
             .collect();
+        let slots = set.dims.iter().map(|&d| d as u64).product::<u64>() * 8;
+        let mut table = Vec::new();
+        if slots <= DENSE_TABLE {
+            table = vec![(0u32, 0u32); slots as usize];
+            for (i, &k) in keys.iter().enumerate() {
+                let e = &mut table[k as usize];
+                if e.1 == 0 {
+                    e.0 = i as u32;
+                }
+                e.1 += 1;
+            }
+        }
         PatchLocator {
             dims: set.dims,
             keys,
             ranges,
             pieces,
             triangle_axis,
+            table,
         }
     }
 
@@ -75,6 +95,10 @@ impl PatchLocator {
             return 0..0;
         }
         let key = group_key(voxel.map(|v| v as u32), axis, self.dims);
+        if !self.table.is_empty() {
+            let (first, count) = self.table[key as usize];
+            return first as usize..(first + count) as usize;
+        }
         let lo = self.keys.partition_point(|&k| k < key);
         let hi = lo + self.keys[lo..].partition_point(|&k| k == key);
         lo..hi
@@ -123,6 +147,12 @@ impl PatchLocator {
     /// The patch a point `p` (grid coordinates) on a surface with dominant `axis` belongs to.
     pub fn locate(&self, p: DVec3, axis: u8) -> Option<u32> {
         let v = voxel_of(p, self.dims);
+        let own = self.candidates(v, axis);
+        if own.len() == 1 {
+            // The common case: one patch of this orientation in the voxel (several only where a
+            // wall thinner than a voxel separates surfaces; then the nearest one decides).
+            return Some(own.start as u32);
+        }
         if let Some((i, d, _)) = self.nearest_in_voxel(p, v, axis) {
             if d <= ON_SURFACE {
                 return Some(i);

@@ -13,6 +13,7 @@
 //! f32 .npy) and [`TRANSPORT_FILE`] (`[channels, n, n]` f32 .npy). docs/baked-format.md describes
 //! them byte by byte.
 
+pub mod fixtures;
 pub mod formfactor;
 pub mod geometry;
 pub mod locate;

@@ -39,7 +39,7 @@ pub struct Visible {
 /// as coplanar (in the faces' coordinates).
 pub fn visible_parts(faces: &[Face], tolerance: f64) -> Visible {
     let mut polygons: Vec<Vec<Polygon>> = faces.iter().map(|f| vec![f.corners.to_vec()]).collect();
-    let mut covered_faces = 0;
+    let mut covered = std::collections::BTreeSet::new();
     let mut covered_area = 0.0;
     for (a, b) in candidate_pairs(faces, tolerance) {
         // Order the pair so that `top` covers `under`.
@@ -60,13 +60,13 @@ pub fn visible_parts(faces: &[Face], tolerance: f64) -> Visible {
             .collect();
         let after: f64 = polygons[under].iter().map(|p| geometry::area(p)).sum();
         if after < before {
-            covered_faces += 1;
+            covered.insert(under);
             covered_area += before - after;
         }
     }
     Visible {
         polygons,
-        covered_faces,
+        covered_faces: covered.len(),
         covered_area,
     }
 }

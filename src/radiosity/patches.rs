@@ -47,6 +47,8 @@ pub struct VoxelizeParams {
 const MAX_VOXELS: f64 = 1e12;
 /// Pieces smaller than this (in voxel areas) are dropped as clipping slivers.
 const MIN_PIECE_AREA: f64 = 1e-12;
+/// Distance (voxels) within which a polygon's extreme counts as lying on a voxel face.
+const SNAP: f64 = 1e-6;
 /// Seed of the per-patch sample points.
 const SAMPLE_SEED: u64 = 0x5a3b_1e5e;
 
@@ -93,7 +95,7 @@ pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
         Resolution::VoxelSize(s) => s,
         Resolution::TargetPatches(n) => choose_voxel_size(&faces, &visible.polygons, extent, n),
     };
-    let dims_f = (extent / size).ceil().max(DVec3::ONE);
+    let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
     if !(size.is_finite() && size > 0.0) || dims_f.x * dims_f.y * dims_f.z > MAX_VOXELS {
         return Err(Error::knob(format!(
             "voxel size {size} gives a grid of {:.0} x {:.0} x {:.0} voxels for a scene of extent {:?}; use a larger voxel size or a smaller target patch count",
@@ -167,9 +169,8 @@ pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
         let sampler = piece_sampler(&set, patch);
         let mut rng = geometry::item_rng(SAMPLE_SEED, i as u64, 0);
         let k = params.samples_per_patch as usize;
-        let (sel, u, v) = (rng.strata(k), rng.strata(k), rng.strata(k));
-        for s in 0..k {
-            let (p, n) = sampler.sample(sel[s], u[s], v[s]);
+        for (u, v) in rng.jittered(k) {
+            let (p, n) = sampler.sample_square(u, v);
             set.samples.push(SurfacePoint {
                 position: frame.to_world(p).as_vec3().to_array(),
                 normal: n.as_vec3().to_array(),
@@ -245,7 +246,9 @@ fn slabs(poly: Polygon, axis: usize, dim: u32) -> Vec<(u32, Polygon)> {
         hi = hi.max(p[axis]);
     }
     let cell = |x: f64| (x.floor().max(0.0) as u64).min(dim as u64 - 1) as u32;
-    let (i0, i1) = (cell(lo), cell(hi));
+    // A polygon that pokes less than SNAP past a voxel face (rounding of coordinates that lie
+    // on the face) is not cut there: no sliver pieces, no sliver patches.
+    let (i0, i1) = (cell(lo + SNAP), cell(hi - SNAP).max(cell(lo + SNAP)));
     let mut out = Vec::with_capacity((i1 - i0 + 1) as usize);
     let mut rest = poly;
     for i in i0..i1 {
@@ -342,7 +345,7 @@ fn triangle_map(scene: &Scene, set: &PatchSet, size: f64) -> PatchLists {
 fn choose_voxel_size(faces: &[Face], polys: &[Vec<Polygon>], extent: DVec3, target: u32) -> f64 {
     let total: f64 = polys.iter().flatten().map(|p| geometry::area(p)).sum();
     let count = |size: f64| -> u64 {
-        let dims_f = (extent / size).ceil().max(DVec3::ONE);
+        let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
         if dims_f.x * dims_f.y * dims_f.z > MAX_VOXELS {
             return u64::MAX;
         }

@@ -399,7 +399,8 @@ impl StageRun for TransportKnobs {
     fn estimate(&self, state: &mut PlanState) -> PlannedStage {
         let n = state.patches as usize;
         let channels = state.channels.max(1);
-        let bytes = memory_estimate(n, channels as usize, self.bounces);
+        // The form factors are already counted as resident by the plan.
+        let bytes = memory_estimate(n, channels as usize, self.bounces) - (n * n) as u64 * 4;
         PlannedStage {
             stage: "transport".into(),
             peak_bytes: bytes,

@@ -95,12 +95,12 @@ impl Transport {
 }
 
 /// Estimated peak bytes of [`transport`]: the form factors, the output, and the working
-/// matrices of one channel (Horner: M, S, scratch in f32; doubling/Auto: one more; infinite:
-/// two f64 matrices plus M).
+/// matrices of one channel (finite and Auto: up to four f32 matrices — M, S, M^j or the newest
+/// bounce, scratch; infinite: the f64 LU factor and solution plus M and S in f32).
 pub fn memory_estimate(n: usize, channels: usize, bounces: Bounces) -> u64 {
     let n2 = (n * n) as u64;
     let working = match bounces {
-        Bounces::Infinite => n2 * (8 + 8 + 4),
+        Bounces::Infinite => n2 * (8 + 8 + 4 + 4),
         _ => n2 * 4 * 4,
     };
     n2 * 4 + channels as u64 * n2 * 4 + working

@@ -2,6 +2,8 @@
 //! coordinates (f32). Two queries: the closest hit (hemisphere shooting) and occlusion of a
 //! segment (pairwise form factors, patch clustering, the transfer's leak test).
 //!
+//! Triangles are tested with a watertight intersection (no rays lost through shared edges).
+//! Rays start slightly behind their origin to dodge obvhs's absolute 1e-4 near-hit cut-off.
 //! Occlusion uses `CwBvh::ray_traverse_miss`, which stops at the first hit below `tmax`;
 //! `ray_traverse_anyhit` is *not* an occlusion test (it visits every hit) — see BUILD-NOTES.
 
@@ -26,6 +28,12 @@ pub struct Visibility {
     /// Smallest ray parameter accepted, in grid units (above f32 self-intersection noise).
     pub epsilon: f32,
 }
+
+/// obvhs's CWBVH node test clamps the entry distance to an absolute 1e-4 (`cwbvh::node::EPSILON`),
+/// so a hit closer than that to the ray's start is lost — a ray leaving a floor point 1e-5 from a
+/// wall would escape through the wall. Rays therefore start `BACKOFF` behind their origin and only
+/// hits at or beyond `BACKOFF` count.
+const BACKOFF: f32 = 2.5e-4;
 
 /// The closest surface a ray hits.
 #[derive(Clone, Copy, Debug)]
@@ -78,18 +86,24 @@ impl Visibility {
         self.tris.is_empty()
     }
 
-    /// The closest hit along `dir` (unit) from `origin`, ignoring hits closer than the epsilon.
+    /// The closest hit along `dir` (unit) from `origin`. Callers start rays slightly off the
+    /// surface (lifted by [`Visibility::epsilon`] along its normal), so every hit with t ≥ 0 counts.
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let d = Vec3A::from(dir.as_vec3());
+        let start = origin - dir * BACKOFF as f64;
+        let wt = Watertight::new(start, dir);
         let ray = Ray::new(
-            Vec3A::from(origin.as_vec3()),
-            d,
-            self.epsilon,
+            Vec3A::from(start.as_vec3()),
+            Vec3A::from(dir.as_vec3()),
+            0.0,
             f32::INFINITY,
         );
         let mut hit = RayHit::none();
         let found = self.bvh.ray_traverse(ray, &mut hit, |r, id| {
-            self.tris[self.bvh.primitive_indices[id] as usize].intersect(r)
+            wt.intersect(
+                &self.tris[self.bvh.primitive_indices[id] as usize],
+                BACKOFF,
+                r.tmax,
+            )
         });
         if !found {
             return None;
@@ -97,30 +111,119 @@ impl Visibility {
         let k = self.bvh.primitive_indices[hit.primitive_id as usize] as usize;
         Some(Hit {
             triangle: self.ids[k],
-            t: hit.t,
-            front: self.normals[k].dot(d) < 0.0,
+            t: hit.t - BACKOFF,
+            front: self.normals[k].dot(ray.direction) < 0.0,
         })
     }
 
-    /// True when a surface lies strictly between `from` and `to` (ignoring an epsilon at both
-    /// ends, so surfaces the end points lie on do not count).
+    /// [`Visibility::closest_hit`] by testing every triangle (for tests of the BVH path).
+    pub fn closest_hit_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
+        let wt = Watertight::new(origin, dir);
+        let d = Vec3A::from(dir.as_vec3());
+        let mut best: Option<Hit> = None;
+        for (k, tri) in self.tris.iter().enumerate() {
+            let t = wt.intersect(tri, 0.0, best.map_or(f32::INFINITY, |b| b.t));
+            if t.is_finite() && best.is_none_or(|b| t < b.t) {
+                best = Some(Hit {
+                    triangle: self.ids[k],
+                    t,
+                    front: self.normals[k].dot(d) < 0.0,
+                });
+            }
+        }
+        best
+    }
+
+    /// True when a surface lies on the segment from `from` to `to` (both lifted off their
+    /// surfaces by the caller).
     pub fn occluded(&self, from: DVec3, to: DVec3) -> bool {
         let delta = to - from;
         let len = delta.length();
-        let eps = self.epsilon as f64;
-        if len <= 2.0 * eps {
+        if len <= 0.0 {
             return false;
         }
         let dir = delta / len;
+        let start = from - dir * BACKOFF as f64;
+        let wt = Watertight::new(start, dir);
         let ray = Ray::new(
-            Vec3A::from(from.as_vec3()),
+            Vec3A::from(start.as_vec3()),
             Vec3A::from(dir.as_vec3()),
-            self.epsilon,
-            (len - eps) as f32,
+            0.0,
+            len as f32 + BACKOFF,
         );
         !self.bvh.ray_traverse_miss(ray, |r, id| {
-            self.tris[self.bvh.primitive_indices[id] as usize].intersect(r)
+            wt.intersect(
+                &self.tris[self.bvh.primitive_indices[id] as usize],
+                BACKOFF,
+                r.tmax,
+            )
         })
+    }
+}
+
+/// Watertight ray/triangle intersection (Woop, Benthin and Wald, JCGT 2013): a ray through the
+/// shared edge or vertex of two triangles hits at least one of them, so closed scenes do not leak
+/// rays through their seams (obvhs's Möller–Trumbore test does).
+struct Watertight {
+    origin: [f32; 3],
+    k: [usize; 3],
+    shear: [f32; 3],
+}
+
+impl Watertight {
+    fn new(origin: DVec3, dir: DVec3) -> Self {
+        let d = dir.as_vec3();
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Watertight {
+            origin: origin.as_vec3().to_array(),
+            k: [kx, ky, kz],
+            shear: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]],
+        }
+    }
+
+    /// Distance to the triangle, or infinity when missed or outside `[tmin, tmax]`.
+    #[inline]
+    fn intersect(&self, tri: &Triangle, tmin: f32, tmax: f32) -> f32 {
+        let [kx, ky, kz] = self.k;
+        let [sx, sy, sz] = self.shear;
+        let o = self.origin;
+        let rel = |v: Vec3A| [v.x - o[0], v.y - o[1], v.z - o[2]];
+        let (a, b, c) = (rel(tri.v0), rel(tri.v1), rel(tri.v2));
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            u = (cx as f64 * by as f64 - cy as f64 * bx as f64) as f32;
+            v = (ax as f64 * cy as f64 - ay as f64 * cx as f64) as f32;
+            w = (bx as f64 * ay as f64 - by as f64 * ax as f64) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return f32::INFINITY;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return f32::INFINITY;
+        }
+        let t = (u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz])) / det;
+        if t >= tmin && t <= tmax {
+            t
+        } else {
+            f32::INFINITY
+        }
     }
 }
 

@@ -8,13 +8,13 @@ use crate::radiosity::PatchSet;
 use glam::Vec3;
 
 /// Direct exitance E of every patch: albedo × mean irradiance over the patch's sample points
-/// (each light's contribution gated by `visible(light, point, to_light, distance)` when shadows
+/// (each light's contribution gated by `visible(light, point, normal, to_light, distance)` when shadows
 /// are on) plus π·L·`emission_scale` for emitters.
 pub fn patch_exitance(
     set: &PatchSet,
     lights: &[GpuLight],
     s: &FrameSettings,
-    visible: &(dyn Fn(usize, Vec3, Vec3, f32) -> bool + Sync),
+    visible: &(dyn Fn(usize, Vec3, Vec3, Vec3, f32) -> bool + Sync),
 ) -> Vec<[f32; 3]> {
     use rayon::prelude::*;
     let spp = set.samples_per_patch as usize;
@@ -29,7 +29,8 @@ pub fn patch_exitance(
                     let (p, n) = (Vec3::from(sp.position), Vec3::from(sp.normal));
                     for (l, light) in lights.iter().enumerate() {
                         let (irr, to_light, dist) = light_irradiance(light, p, n);
-                        if irr.max_element() > 0.0 && (!s.shadows || visible(l, p, to_light, dist))
+                        if irr.max_element() > 0.0
+                            && (!s.shadows || visible(l, p, n, to_light, dist))
                         {
                             h += irr;
                         }

@@ -77,7 +77,7 @@ pub fn corner_vertices(scene: &Scene) -> Vec<f32> {
 }
 
 /// Outgoing radiance at a surface point: twin of `shade_point` in mesh_shade.wgsl.
-/// `visible(light_index, p, to_light, distance)` answers whether the light reaches `p`.
+/// `visible(light_index, p, n, to_light, distance)` answers whether the light reaches `p`.
 #[allow(clippy::too_many_arguments)]
 pub fn shade_point(
     s: &FrameSettings,
@@ -87,14 +87,14 @@ pub fn shade_point(
     albedo: Vec3,
     emission: Vec3,
     indirect: Vec3,
-    visible: &dyn Fn(usize, Vec3, Vec3, f32) -> bool,
+    visible: &dyn Fn(usize, Vec3, Vec3, Vec3, f32) -> bool,
 ) -> Vec3 {
     let mut radiance = Vec3::ZERO;
     if s.direct {
         let mut h = Vec3::ZERO;
         for (i, l) in lights.iter().enumerate() {
             let (irr, to_light, dist) = light_irradiance(l, p, n);
-            if irr.max_element() > 0.0 && (!s.shadows || visible(i, p, to_light, dist)) {
+            if irr.max_element() > 0.0 && (!s.shadows || visible(i, p, n, to_light, dist)) {
                 h += irr;
             }
         }

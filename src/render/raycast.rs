@@ -66,14 +66,16 @@ impl RaycastScene {
     ) -> image::RgbaImage {
         let bg = s.background.map(to_u8);
         let far = 4.0 * self.extent;
-        let visible = |l: usize, p: Vec3, to_light: Vec3, dist: f32| {
+        let eps = self.vis.epsilon;
+        let visible = |l: usize, p: Vec3, n: Vec3, to_light: Vec3, dist: f32| {
             let light = &lights[l];
             let end = if light.kind() == KIND_DIRECTIONAL {
                 p + to_light * far
             } else {
                 p + to_light * dist
             };
-            !self.vis.occluded(p.as_dvec3(), end.as_dvec3())
+            // Shadow rays leave the surface lifted by the BVH's epsilon along the normal.
+            !self.vis.occluded((p + n * eps).as_dvec3(), end.as_dvec3())
         };
         let rows: Vec<Vec<u8>> = (0..height)
             .into_par_iter()

@@ -1,9 +1,12 @@
 //! Hemisphere shooting: from each patch, N rays with origins stratified over the patch's area and
-//! cosine-distributed directions about the local surface normal; `F_ij ≈ hits_j / N`.
+//! cosine-distributed directions about the local surface normal; `F_ij ≈ hits_j / N`. Rays start
+//! a ray epsilon above the surface (never on it), so a ray leaving a concave corner hits the
+//! adjoining wall instead of slipping out behind it.
 //!
 //! A cosine-distributed direction has density cosθ/π, which is exactly the form-factor kernel of
-//! a differential area, so each hit counts 1/N (Malley's method). Origins, the choice of fan
-//! triangle and the two direction coordinates are each Latin-hypercube stratified. A ray that
+//! a differential area, so each hit counts 1/N (Malley's method). Origins (over the patch's
+//! area) and directions (over the unit square before the cosine warp) are each jittered-stratified,
+//! and paired at random. A ray that
 //! hits a back face (the inside of a closed object, the outside of a wall) is absorbed: nobody
 //! receives it, and by reciprocity nothing there could see patch i. Rows of a closed scene sum
 //! to 1 by construction.
@@ -46,12 +49,14 @@ pub fn shoot(ctx: &Context, i: usize, k: usize, seed: u64, unassigned: &AtomicU6
         return counts;
     }
     let mut rng = item_rng(seed, i as u64, u64::MAX);
-    let (sel, u, v) = (rng.strata(k), rng.strata(k), rng.strata(k));
-    let (du, dv) = (rng.strata(k), rng.strata(k));
+    let origins = rng.jittered(k);
+    let directions = rng.jittered(k);
     let mut lost = 0;
+    let lift = ctx.vis.epsilon as f64;
     for s in 0..k {
-        let (origin, normal) = sampler.sample(sel[s], u[s], v[s]);
-        let dir = cosine_direction(normal, du[s], dv[s]);
+        let (origin, normal) = sampler.sample_square(origins[s].0, origins[s].1);
+        let dir = cosine_direction(normal, directions[s].0, directions[s].1);
+        let origin = origin + normal * lift;
         let Some(hit) = ctx.vis.closest_hit(origin, dir) else {
             continue;
         };

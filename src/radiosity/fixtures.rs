@@ -1,0 +1,214 @@
+//! Synthetic scenes with known answers, for tests and benchmarks: the analytic configurations
+//! of [`super::formfactor::analytic`], closed boxes (furnace tests) and two rooms separated by a
+//! thin wall (the transfer's leak test).
+
+use crate::scene::{Material, Scene};
+use glam::DVec3;
+
+/// Builds a [`Scene`] from quads and polygons.
+#[derive(Default)]
+pub struct SceneBuilder {
+    scene: Scene,
+}
+
+impl SceneBuilder {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Add a material; returns its index.
+    pub fn material(&mut self, name: &str, albedo: [f32; 3], emission: [f32; 3]) -> u32 {
+        self.scene.materials.push(Material {
+            name: name.into(),
+            albedo,
+            emission,
+        });
+        (self.scene.materials.len() - 1) as u32
+    }
+
+    fn object(&mut self, name: &str) -> u32 {
+        match self.scene.objects.iter().position(|o| o == name) {
+            Some(i) => i as u32,
+            None => {
+                self.scene.objects.push(name.into());
+                (self.scene.objects.len() - 1) as u32
+            }
+        }
+    }
+
+    /// A triangle (counter-clockwise front face).
+    pub fn triangle(&mut self, object: &str, corners: [DVec3; 3], material: u32) {
+        let o = self.object(object);
+        let base = self.scene.positions.len() as u32;
+        for c in corners {
+            self.scene.positions.push(c.as_vec3().to_array());
+        }
+        self.scene.triangles.push([base, base + 1, base + 2]);
+        self.scene.triangle_material.push(material);
+        self.scene.triangle_object.push(o);
+    }
+
+    /// A convex polygon as a triangle fan (counter-clockwise about its front normal).
+    pub fn polygon(&mut self, object: &str, corners: &[DVec3], material: u32) {
+        for i in 1..corners.len() - 1 {
+            self.triangle(object, [corners[0], corners[i], corners[i + 1]], material);
+        }
+    }
+
+    /// The rectangle `centre ± u ± v` facing `u × v`.
+    pub fn rectangle(&mut self, object: &str, centre: DVec3, u: DVec3, v: DVec3, material: u32) {
+        self.polygon(
+            object,
+            &[
+                centre - u - v,
+                centre + u - v,
+                centre + u + v,
+                centre - u + v,
+            ],
+            material,
+        );
+    }
+
+    /// A regular `segments`-gon of circumradius `r` at `centre` facing `normal`.
+    pub fn disc(
+        &mut self,
+        object: &str,
+        centre: DVec3,
+        normal: DVec3,
+        r: f64,
+        segments: usize,
+        material: u32,
+    ) {
+        let n = normal.normalize();
+        let (t, b) = crate::radiosity::geometry::basis(n);
+        let pts: Vec<DVec3> = (0..segments)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / segments as f64;
+                centre + r * (t * a.cos() + b * a.sin())
+            })
+            .collect();
+        self.polygon(object, &pts, material);
+    }
+
+    /// The six inward-facing faces of the box `[lo, hi]`.
+    pub fn box_inside(&mut self, object: &str, lo: DVec3, hi: DVec3, material: u32) {
+        let c = (lo + hi) / 2.0;
+        let h = (hi - lo) / 2.0;
+        let (x, y, z) = (DVec3::X * h.x, DVec3::Y * h.y, DVec3::Z * h.z);
+        // Each face's u × v points into the box.
+        self.rectangle(object, c - x, y, z, material); // normal +x... y × z = +x
+        self.rectangle(object, c + x, z, y, material); // z × y = −x
+        self.rectangle(object, c - y, z, x, material); // z × x = +y
+        self.rectangle(object, c + y, x, z, material); // x × z = −y
+        self.rectangle(object, c - z, x, y, material); // x × y = +z
+        self.rectangle(object, c + z, y, x, material); // y × x = −z
+    }
+
+    pub fn build(self) -> Scene {
+        self.scene
+    }
+}
+
+/// Howell C-11: rectangles `a × b` at y = 0 (facing +y) and y = c (facing −y).
+pub fn parallel_rectangles(a: f64, b: f64, c: f64) -> Scene {
+    let mut s = SceneBuilder::new();
+    let m = s.material("grey", [0.5; 3], [0.0; 3]);
+    let (u, v) = (DVec3::X * a / 2.0, DVec3::Z * b / 2.0);
+    let centre = DVec3::new(a / 2.0, 0.0, b / 2.0);
+    s.rectangle("bottom", centre, u, -v, m);
+    s.rectangle("top", centre + DVec3::Y * c, u, v, m);
+    s.build()
+}
+
+/// Howell C-14: `w × l` at y = 0 (facing +y, z ∈ [0, w]) and `h × l` at z = 0 (facing +z,
+/// y ∈ [0, h]), sharing the edge x ∈ [0, l].
+pub fn perpendicular_rectangles(w: f64, h: f64, l: f64) -> Scene {
+    let mut s = SceneBuilder::new();
+    let m = s.material("grey", [0.5; 3], [0.0; 3]);
+    let hx = DVec3::X * l / 2.0;
+    s.rectangle(
+        "floor",
+        DVec3::new(l / 2.0, 0.0, w / 2.0),
+        hx,
+        -DVec3::Z * w / 2.0,
+        m,
+    );
+    s.rectangle(
+        "wall",
+        DVec3::new(l / 2.0, h / 2.0, 0.0),
+        hx,
+        DVec3::Y * h / 2.0,
+        m,
+    );
+    s.build()
+}
+
+/// Coaxial discs (regular `segments`-gons): radius `r1` at y = 0 facing +y, `r2` at y = h
+/// facing −y.
+pub fn coaxial_discs(r1: f64, r2: f64, h: f64, segments: usize) -> Scene {
+    let mut s = SceneBuilder::new();
+    let m = s.material("grey", [0.5; 3], [0.0; 3]);
+    s.disc("bottom", DVec3::ZERO, DVec3::Y, r1, segments, m);
+    s.disc("top", DVec3::Y * h, -DVec3::Y, r2, segments, m);
+    s.build()
+}
+
+/// Radius of the circle with the area of a regular `segments`-gon of circumradius `r`.
+pub fn equal_area_radius(r: f64, segments: usize) -> f64 {
+    let k = segments as f64;
+    r * (k * (std::f64::consts::TAU / k).sin() / std::f64::consts::TAU).sqrt()
+}
+
+/// Howell B-3: a small square element of side `e` centred at the origin facing +y, and the
+/// rectangle x ∈ [0, a], z ∈ [0, b] at y = c facing −y (the element's normal passes through a
+/// corner).
+pub fn element_and_rectangle(e: f64, a: f64, b: f64, c: f64) -> Scene {
+    let mut s = SceneBuilder::new();
+    let m = s.material("grey", [0.5; 3], [0.0; 3]);
+    s.rectangle(
+        "element",
+        DVec3::ZERO,
+        DVec3::X * e / 2.0,
+        -DVec3::Z * e / 2.0,
+        m,
+    );
+    s.rectangle(
+        "rectangle",
+        DVec3::new(a / 2.0, c, b / 2.0),
+        DVec3::X * a / 2.0,
+        DVec3::Z * b / 2.0,
+        m,
+    );
+    s.build()
+}
+
+/// A closed box `[0, size]` (inward faces) with uniform albedo and emitted radiance.
+pub fn closed_box(size: [f64; 3], albedo: f32, emission: f32) -> Scene {
+    let mut s = SceneBuilder::new();
+    let m = s.material("uniform", [albedo; 3], [emission; 3]);
+    s.box_inside("box", DVec3::ZERO, DVec3::from(size), m);
+    s.build()
+}
+
+/// Two closed unit rooms side by side, x ∈ [0, 1] and [1 + t, 2 + t], separated by a wall of
+/// thickness `t`; room A (the first) has a light quad in its ceiling plane.
+pub fn thin_wall_rooms(t: f64) -> Scene {
+    let mut s = SceneBuilder::new();
+    let white = s.material("white", [0.7; 3], [0.0; 3]);
+    let light = s.material("light", [0.7; 3], [10.0; 3]);
+    s.box_inside("room_a", DVec3::ZERO, DVec3::ONE, white);
+    s.box_inside(
+        "room_b",
+        DVec3::new(1.0 + t, 0.0, 0.0),
+        DVec3::new(2.0 + t, 1.0, 1.0),
+        white,
+    );
+    s.rectangle(
+        "light",
+        DVec3::new(0.5, 1.0, 0.5),
+        DVec3::X * 0.15,
+        DVec3::Z * 0.15,
+        light,
+    );
+    s.build()
+}
