@@ -541,7 +541,7 @@ fn pipelines(
     Ok((shade, shadow))
 }
 
-fn targets(
+pub(crate) fn targets(
     gpu: &Gpu,
     width: u32,
     height: u32,

@@ -10,6 +10,7 @@ pub mod compressed_gather;
 pub mod compute;
 pub mod mesh_renderer;
 pub mod radiosity_runtime;
+pub mod terrain_renderer;
 pub mod readback;
 pub mod timing;
 
@@ -173,6 +174,9 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "lighting.wgsl",
     "mesh_shade.wgsl",
     "shadow_depth.wgsl",
+    "terrain_mask.wgsl",
+    "terrain_render.wgsl",
+    "terrain_shadow.wgsl",
     "tonemap_test.wgsl",
 ];
 

@@ -5,4 +5,5 @@ pub mod direct;
 pub mod lights;
 pub mod mesh_reference;
 pub mod raycast;
+pub mod terrain_shading;
 pub mod tonemap;

@@ -1,0 +1,352 @@
+//! Terrain on the GPU: the height field and its min/max mipmap in storage buffers, per-sun
+//! track uniforms, the hard-shadow mask kernel (`terrain_mask.wgsl`, tested against
+//! `terrain::relief::shadow_mask`) and the terrain frame (`terrain_render.wgsl`, tested against
+//! `render::terrain_shading`).
+
+use super::{compute, timing::PassTimer, Gpu};
+use crate::error::{Error, Result};
+use crate::heightmap::HeightMap;
+use crate::render::terrain_shading::TerrainSettings;
+use crate::terrain::sun::{Sun, Track, TrackKind};
+use crate::terrain::MinMaxMipmap;
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+struct TerrainParams {
+    width: u32,
+    height: u32,
+    levels: u32,
+    kind: u32,
+    step_x: i32,
+    step_y: i32,
+    pad0: [u32; 2],
+    ux: f32,
+    uy: f32,
+    inv_ux: f32,
+    inv_uy: f32,
+    rise_per_t: f32,
+    max_height: f32,
+    pad1: [u32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct TerrainFrame {
+    view_proj: [f32; 16],
+    eye: [f32; 4],
+    sun: [f32; 4],
+    cell: [f32; 4],
+    fog: [f32; 4],
+    exposure: f32,
+    flags: u32,
+    min_height: f32,
+    max_height_tint: f32,
+}
+
+/// GPU state for one height map.
+pub struct TerrainRenderer {
+    map_size: (u32, u32),
+    cell: [f32; 2],
+    heights_range: (f32, f32),
+    params: wgpu::Buffer,
+    params_cpu: TerrainParams,
+    mask_pipeline: wgpu::ComputePipeline,
+    mask_groups: [wgpu::BindGroup; 2],
+    mask_params: wgpu::Buffer,
+    mask_out: wgpu::Buffer,
+    render_pipeline: wgpu::RenderPipeline,
+    render_groups: [wgpu::BindGroup; 2],
+    frame: wgpu::Buffer,
+    grid: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+    grid_step: u32,
+    target: wgpu::Texture,
+    target_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    pub width: u32,
+    pub height: u32,
+    sun: Sun,
+}
+
+/// Most grid vertices along a side of the display mesh (the shading is per texel regardless).
+pub const MAX_GRID: u32 = 1024;
+
+impl TerrainRenderer {
+    /// Upload `map` and `mip` and create a `width`×`height` target. `grid_step` None picks the
+    /// display-mesh decimation so that at most [`MAX_GRID`] vertices span a side.
+    pub fn new(gpu: &Gpu, map: &HeightMap, mip: &MinMaxMipmap, width: u32, height: u32, grid_step: Option<u32>) -> Result<Self> {
+        if (mip.map_width, mip.map_height) != (map.width, map.height) {
+            return Err(Error::Internal("mipmap and height map sizes differ".into()));
+        }
+        let bytes = (map.heights.len() * 4) as u64;
+        if bytes > gpu.info.max_storage_buffer_binding_size {
+            return Err(Error::limit(format!(
+                "a {}x{} height map needs {} MiB, over the adapter's {} MiB storage binding limit",
+                map.width,
+                map.height,
+                bytes >> 20,
+                gpu.info.max_storage_buffer_binding_size >> 20
+            )));
+        }
+        let heights = compute::storage(gpu, "heights", &map.heights);
+        let mip_data = compute::storage(gpu, "minmax mipmap", &mip.data);
+        let levels: Vec<[u32; 4]> = mip.levels.iter().map(|l| [l.width as u32, l.height as u32, l.offset as u32, 0]).collect();
+        let mip_levels = compute::storage(gpu, "mip levels", &levels);
+        let params_cpu = TerrainParams { width: map.width as u32, height: map.height as u32, levels: mip.levels.len() as u32, ..Default::default() };
+        let params = compute::uniform(gpu, "terrain params", &params_cpu);
+        let terrain_entries = |layout: &wgpu::BindGroupLayout| {
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("terrain"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: heights.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: mip_data.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: mip_levels.as_entire_binding() },
+                ],
+            })
+        };
+
+        let mask_pipeline = compute::pipeline(gpu, "terrain_mask.wgsl", "main")?;
+        let mask_params = compute::uniform(gpu, "mask params", &[0u32; 4]);
+        let mask_out = compute::output(gpu, "mask", (map.width * map.height * 4) as u64);
+        let mask_group0 = compute::bind(gpu, &mask_pipeline, &[mask_params.as_entire_binding(), mask_out.as_entire_binding()]);
+        let mask_groups = [mask_group0, terrain_entries(&mask_pipeline.get_bind_group_layout(1))];
+
+        let module = gpu.shader("terrain_render.wgsl")?;
+        let render_pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("terrain"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 8,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 0, shader_location: 0 }],
+                })],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(super::mesh_renderer::TARGET_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let frame = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("terrain frame"),
+            size: std::mem::size_of::<TerrainFrame>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let g0 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("terrain frame"),
+            layout: &render_pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() }],
+        });
+        let render_groups = [g0, terrain_entries(&render_pipeline.get_bind_group_layout(1))];
+
+        let step = grid_step.unwrap_or_else(|| (map.width.max(map.height) as u32).div_ceil(MAX_GRID)).max(1);
+        let (grid, indices, index_count) = grid_mesh(gpu, map.width as u32, map.height as u32, step);
+        let (target, target_view, depth_view) = super::mesh_renderer::targets(gpu, width, height);
+        let (lo, hi) = map.min_max();
+        let mut r = TerrainRenderer {
+            map_size: (map.width as u32, map.height as u32),
+            cell: [map.cell_size[0] as f32, map.cell_size[1] as f32],
+            heights_range: (lo, hi),
+            params,
+            params_cpu,
+            mask_pipeline,
+            mask_groups,
+            mask_params,
+            mask_out,
+            render_pipeline,
+            render_groups,
+            frame,
+            grid,
+            indices,
+            index_count,
+            grid_step: step,
+            target,
+            target_view,
+            depth_view,
+            width,
+            height,
+            sun: Sun::new(135.0, 30.0)?,
+        };
+        r.params_cpu.max_height = mip.max_height;
+        r.set_sun(gpu, Sun::new(135.0, 30.0)?);
+        Ok(r)
+    }
+
+    /// Set the sun: the track constants of `terrain::sun::Track`, rounded to f32.
+    pub fn set_sun(&mut self, gpu: &Gpu, sun: Sun) {
+        let t = Track::new(&sun, [self.cell[0] as f64, self.cell[1] as f64]);
+        let p = &mut self.params_cpu;
+        p.kind = match t.kind {
+            TrackKind::Ray => 0,
+            TrackKind::Zenith => 1,
+            TrackKind::BelowHorizon => 2,
+        };
+        p.step_x = t.step_x as i32;
+        p.step_y = t.step_y as i32;
+        p.ux = t.ux as f32;
+        p.uy = t.uy as f32;
+        p.inv_ux = t.inv_ux as f32;
+        p.inv_uy = t.inv_uy as f32;
+        p.rise_per_t = t.rise_per_t as f32;
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(p));
+        self.sun = sun;
+    }
+
+    /// The hard-shadow mask of every texel (row-major, true = shadow), computed on the GPU.
+    pub fn shadow_mask(&self, gpu: &Gpu, accelerated: bool) -> Result<Vec<bool>> {
+        gpu.queue.write_buffer(&self.mask_params, 0, bytemuck::cast_slice(&[accelerated as u32, 0, 0, 0]));
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.mask_pipeline);
+            pass.set_bind_group(0, &self.mask_groups[0], &[]);
+            pass.set_bind_group(1, &self.mask_groups[1], &[]);
+            pass.dispatch_workgroups(self.map_size.0.div_ceil(8), self.map_size.1.div_ceil(8), 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let words = super::readback::read_buffer(gpu, &self.mask_out)?;
+        let words: &[u32] = bytemuck::cast_slice(&words);
+        Ok(words[..(self.map_size.0 * self.map_size.1) as usize].iter().map(|&w| w != 0).collect())
+    }
+
+    /// A camera over the map from the south-east, looking at its centre (world: x east, y up,
+    /// z south; vertical exaggeration from `s`).
+    pub fn default_view(&self, s: &TerrainSettings) -> (Vec3, Vec3) {
+        let w = self.map_size.0 as f32 * self.cell[0];
+        let d = self.map_size.1 as f32 * self.cell[1];
+        let centre = Vec3::new(0.5 * w, self.heights_range.0 * s.vertical_exaggeration, 0.5 * d);
+        let size = w.max(d);
+        (centre + Vec3::new(0.35 * size, 0.55 * size, 0.85 * size), centre)
+    }
+
+    /// Record the terrain frame for `view_proj` seen from `eye`.
+    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, view_proj: Mat4, eye: Vec3, s: &TerrainSettings, timer: &mut PassTimer) {
+        let dir = self.sun.direction();
+        let k = crate::terrain::relief::k_shadow(&self.sun, s.k_dark as f64, s.k_bright as f64) as f32;
+        let f = TerrainFrame {
+            view_proj: view_proj.to_cols_array(),
+            eye: eye.extend(1.0).to_array(),
+            sun: [dir[0] as f32, dir[1] as f32, dir[2] as f32, k],
+            cell: [self.cell[0], self.cell[1], s.vertical_exaggeration, self.grid_step as f32],
+            fog: [s.fog_extinction, s.fog_albedo, s.fog_anisotropy, s.sun_strength],
+            exposure: s.exposure,
+            flags: s.shadows as u32 | (s.fog as u32) << 1,
+            min_height: self.heights_range.0,
+            max_height_tint: self.heights_range.1,
+        };
+        gpu.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
+        let bg = s.background;
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("terrain"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.target_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 1.0 }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.render("terrain"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.render_pipeline);
+        pass.set_bind_group(0, &self.render_groups[0], &[]);
+        pass.set_bind_group(1, &self.render_groups[1], &[]);
+        pass.set_vertex_buffer(0, self.grid.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.index_count, 0, 0..1);
+    }
+
+    pub fn target_view(&self) -> &wgpu::TextureView {
+        &self.target_view
+    }
+
+    pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
+        let (t, tv, dv) = super::mesh_renderer::targets(gpu, width.max(1), height.max(1));
+        (self.target, self.target_view, self.depth_view) = (t, tv, dv);
+        (self.width, self.height) = (width.max(1), height.max(1));
+    }
+
+    pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
+        let px = super::readback::read_texture_4bpp(gpu, &self.target)?;
+        image::RgbaImage::from_raw(self.width, self.height, px).ok_or_else(|| Error::Internal("readback size".into()))
+    }
+
+    /// The top-down orthographic view in which pixel (x, y) of a map-sized image sees the
+    /// centre of texel (x, y) (north up): the map view of the twin test.
+    pub fn map_view(&self) -> (Mat4, Vec3) {
+        let (w, h) = (self.map_size.0 as f32 * self.cell[0], self.map_size.1 as f32 * self.cell[1]);
+        let top = self.heights_range.1.abs().max(self.heights_range.0.abs()) * 4.0 + 1.0;
+        let eye = Vec3::new(0.0, top, 0.0);
+        // Looking down −y with north (−z) up in the image.
+        let view = crate::render::camera::look_at(eye, eye - Vec3::Y, Vec3::NEG_Z);
+        let proj = crate::render::camera::orthographic(0.0, w, -h, 0.0, 0.0, 2.0 * top + 1.0);
+        (proj * view, eye)
+    }
+}
+
+/// Grid vertices at texel centres every `step` texels (always including the last row and
+/// column) and two triangles per cell.
+fn grid_mesh(gpu: &Gpu, w: u32, h: u32, step: u32) -> (wgpu::Buffer, wgpu::Buffer, u32) {
+    let axis = |n: u32| -> Vec<u32> {
+        let mut v: Vec<u32> = (0..n).step_by(step as usize).collect();
+        if *v.last().unwrap() != n - 1 {
+            v.push(n - 1);
+        }
+        v
+    };
+    let (xs, ys) = (axis(w), axis(h));
+    let verts: Vec<[f32; 2]> = ys.iter().flat_map(|&y| xs.iter().map(move |&x| [x as f32 + 0.5, y as f32 + 0.5])).collect();
+    let nx = xs.len() as u32;
+    let mut idx = Vec::new();
+    for j in 0..ys.len() as u32 - 1 {
+        for i in 0..nx - 1 {
+            let a = j * nx + i;
+            idx.extend_from_slice(&[a, a + nx, a + 1, a + 1, a + nx, a + nx + 1]);
+        }
+    }
+    if idx.is_empty() {
+        // A one-texel-wide map: a degenerate strip still draws nothing; keep the buffer valid.
+        idx.extend_from_slice(&[0, 0, 0]);
+    }
+    let vb = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("terrain grid"),
+        contents: bytemuck::cast_slice(&verts),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let ib = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("terrain indices"),
+        contents: bytemuck::cast_slice(&idx),
+        usage: wgpu::BufferUsages::INDEX,
+    });
+    (vb, ib, idx.len() as u32)
+}

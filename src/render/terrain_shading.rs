@@ -1,0 +1,88 @@
+//! The CPU twin of the terrain shading in `shaders/terrain_render.wgsl`: the same hypsometric
+//! tint, the same texel radiance (Lambert from `terrain::relief::lambert`, the seed's shadow
+//! brightness k_shadow) and the same tone map, evaluated per texel — what the GPU shows in the
+//! top-down map view, pixel for texel.
+
+use super::tonemap::{tonemap, to_u8};
+use crate::heightmap::HeightMap;
+use crate::terrain::relief::{k_shadow, lambert};
+use crate::terrain::sun::Sun;
+use serde::{Deserialize, Serialize};
+
+/// Display knobs of a terrain frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TerrainSettings {
+    pub exposure: f32,
+    /// Shadow brightness in a full shadow when the sun is at the horizon / at the zenith.
+    pub k_dark: f32,
+    pub k_bright: f32,
+    /// Multiplies heights for display (1 = true scale).
+    pub vertical_exaggeration: f32,
+    pub shadows: bool,
+    /// Aerial perspective (seed 001's scattered light), per pixel.
+    pub fog: bool,
+    /// Extinction β_ext per metre.
+    pub fog_extinction: f32,
+    /// Scattering albedo β_sc/β_ext.
+    pub fog_albedo: f32,
+    /// Henyey-Greenstein anisotropy g of the phase function.
+    pub fog_anisotropy: f32,
+    /// Sun irradiance scale.
+    pub sun_strength: f32,
+    pub background: [f32; 3],
+}
+
+impl Default for TerrainSettings {
+    fn default() -> Self {
+        TerrainSettings {
+            exposure: 1.5,
+            k_dark: 0.25,
+            k_bright: 0.6,
+            vertical_exaggeration: 2.0,
+            shadows: true,
+            fog: true,
+            fog_extinction: 1.0 / 120_000.0,
+            fog_albedo: 0.8,
+            fog_anisotropy: 0.6,
+            sun_strength: 1.0,
+            background: [0.55, 0.65, 0.8],
+        }
+    }
+}
+
+/// Hypsometric tint (linear RGB) at relative height t ∈ [0, 1]: twin of `tint`.
+pub fn tint(t: f32) -> [f32; 3] {
+    let t = t.clamp(0.0, 1.0);
+    let low = [0.10, 0.25, 0.08];
+    let mid = [0.35, 0.30, 0.18];
+    let high = [0.80, 0.80, 0.80];
+    let mix = |a: [f32; 3], b: [f32; 3], s: f32| [0, 1, 2].map(|c| a[c] * (1.0 - s) + b[c] * s);
+    if t < 0.5 {
+        mix(low, mid, t * 2.0)
+    } else {
+        mix(mid, high, t * 2.0 - 1.0)
+    }
+}
+
+/// Radiance of a texel before fog: twin of `texel_radiance`.
+pub fn texel_radiance(s: &TerrainSettings, t: f32, lambert: f32, shadow: f32, k: f32) -> [f32; 3] {
+    let relief = lambert * (1.0 - (1.0 - k) * shadow);
+    tint(t).map(|c| c * (s.sun_strength * relief + 0.15))
+}
+
+/// The map view (one pixel per texel, north up, no fog) of `map` under `sun` with per-texel
+/// shadowed fraction `shadow` (1 = hard shadow).
+pub fn map_view(map: &HeightMap, sun: &Sun, shadow: &[f32], s: &TerrainSettings) -> image::RgbaImage {
+    let lam = lambert(map, sun);
+    let k = k_shadow(sun, s.k_dark as f64, s.k_bright as f64) as f32;
+    let (lo, hi) = map.min_max();
+    let span = (hi - lo).max(1e-6);
+    let mut img = image::RgbaImage::new(map.width as u32, map.height as u32);
+    for (i, px) in img.pixels_mut().enumerate() {
+        let t = (map.heights[i] - lo) / span;
+        let sh = if s.shadows { shadow[i] } else { 0.0 };
+        let c = tonemap(texel_radiance(s, t, lam[i], sh, k), s.exposure);
+        *px = image::Rgba([to_u8(c[0]), to_u8(c[1]), to_u8(c[2]), 255]);
+    }
+    img
+}
