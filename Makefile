@@ -25,6 +25,8 @@ demo: build
 	$(BAKE) inspect out/demo/puget-sound
 	$(BAKE) shadow pipelines/puget-sound.ron --sun-azimuth 300 --sun-elevation 10 \
 	    --out out/demo/puget-sound-shadow.png --shaded out/demo/puget-sound-relief.png
+	$(BAKE) softshadow pipelines/puget-sound.ron --sun-azimuth 300 --sun-elevation 3 \
+	    --out out/demo/puget-sound-lit.png --shaded out/demo/puget-sound-soft-relief.png
 	@echo
 	@echo "demo output is in out/demo/"
 

@@ -5,6 +5,7 @@
 //! - [`minmax_mipmap`]: the min/max mipmap (the `minmax_mipmap` pipeline stage);
 //! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
 //! - [`relief`]: whole-image shadow masks and shaded relief;
+//! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
 //! - [`generate`]: synthetic height maps (stress maps and analytic shapes);
 //! - [`images`]: writing masks and reliefs (PNG/EXR) atomically.
 //!
@@ -18,6 +19,7 @@ pub mod images;
 pub mod minmax_mipmap;
 pub mod mipmap_stage;
 pub mod relief;
+pub mod soft;
 pub mod sun;
 
 pub use minmax_mipmap::MinMaxMipmap;
