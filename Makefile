@@ -29,6 +29,8 @@ demo: build
 	$(BAKE) inspect out/demo/puget-sound
 	$(BAKE) shadow pipelines/puget-sound.ron --sun-azimuth 300 --sun-elevation 10 \
 	    --out out/demo/puget-sound-shadow.png --shaded out/demo/puget-sound-relief.png
+	$(BAKE) softshadow pipelines/puget-sound.ron --sun-azimuth 300 --sun-elevation 3 \
+	    --out out/demo/puget-sound-lit.png --shaded out/demo/puget-sound-soft-relief.png
 	@mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
 	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --out out/demo/cornell-frames
 	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --sun 135,25 --frames 4 --out out/demo/cornell-sun-frames

@@ -13,43 +13,9 @@ use relume::terrain::accelerated_traversal::shadowed_accelerated;
 use relume::terrain::exact_traversal::shadowed_exact;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 use std::time::Instant;
+use util::{cpu_seconds, env, load};
 
-fn env<T: std::str::FromStr>(name: &str, default: T) -> T {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-fn puget() -> HeightMap {
-    let root = env!("CARGO_MANIFEST_DIR");
-    let p = relume::pipeline::parse_pipeline(std::path::Path::new(&format!(
-        "{root}/pipelines/puget-sound.ron"
-    )))
-    .unwrap();
-    match relume::load::load_input(&p.input).unwrap() {
-        relume::load::LoadedInput::HeightMap(m, _) => m,
-        _ => unreachable!(),
-    }
-}
-
-/// CPU seconds (user + system) of this process so far, from /proc/self/stat (Linux; 0 elsewhere).
-/// On a shared machine CPU time is a steadier measure than wall time.
-pub fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit_once(')').map(|(_, a)| a).unwrap_or("");
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    // Fields after the command name start at field 3 (state, a letter, is skipped by the
-    // parse): utime and stime are fields 14 and 15, in clock ticks of 1/100 s.
-    if f.len() > 12 {
-        (f[10] + f[11]) / 100.0
-    } else {
-        0.0
-    }
-}
+mod util;
 
 /// (wall seconds, CPU seconds, mask) over the given rows.
 fn run(
@@ -66,7 +32,7 @@ fn run(
 }
 
 fn main() {
-    let full = puget();
+    let full = load("puget-sound.ron");
     let az: f64 = env("RELUME_BENCH_AZIMUTH", 300.0);
     let row_step: usize = env("RELUME_BENCH_ROW_STEP", 1);
     let sizes: Vec<usize> = env::<String>("RELUME_BENCH_SIZES", "1024,2048,4096".into())

@@ -373,3 +373,109 @@ print(len(levels))
     );
     assert_eq!(out.trim(), "10");
 }
+
+#[test]
+fn softshadow_writes_16_bit_png_and_exr_and_methods_agree() {
+    let dir = tempfile::tempdir().unwrap();
+    let wall = dir.path().join("cone.exr");
+    expect_code(
+        &bake(
+            dir.path(),
+            &["generate", "cone", "--size", "96", "--out", s(&wall), "-q"],
+        ),
+        0,
+    );
+    let mut exrs = Vec::new();
+    for method in [
+        "exhaustive",
+        "branch-and-bound",
+        "uniform",
+        "dynamic-programming",
+    ] {
+        let png = dir.path().join(format!("{method}.png"));
+        let exr = dir.path().join(format!("{method}.exr"));
+        let relief = dir.path().join(format!("{method}-relief.png"));
+        for (out, extra) in [(&png, Some(&relief)), (&exr, None)] {
+            let mut args = vec![
+                "softshadow",
+                s(&wall),
+                "--sun-azimuth",
+                "250",
+                "--sun-elevation",
+                "8",
+                "--sun-radius",
+                "1.5",
+                "--method",
+                method,
+                "--out",
+                s(out),
+                "--json",
+            ];
+            if let Some(r) = extra {
+                args.extend_from_slice(&["--shaded", s(r)]);
+            }
+            let o = bake(dir.path(), &args);
+            expect_code(&o, 0);
+            let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            assert!(j["penumbra_fraction"].as_f64().unwrap() > 0.0, "{method}");
+        }
+        let img = image::open(&png).unwrap();
+        assert_eq!(img.color(), image::ColorType::L16);
+        assert_eq!(
+            image::open(&relief).unwrap().to_luma8().dimensions(),
+            (96, 96)
+        );
+        let (w, h, ch) = relume::baked::exr_io::read_f32_channels(&exr).unwrap();
+        assert_eq!((w, h), (96, 96));
+        // The PNG holds the same values, quantised to 16 bits.
+        let px = img.to_luma16();
+        for (p, v) in px.pixels().zip(&ch[0].1) {
+            assert!((p.0[0] as f32 / 65535.0 - v).abs() <= 1.0 / 65535.0);
+        }
+        exrs.push(ch[0].1.clone());
+    }
+    // Branch-and-bound equals the exhaustive reference.
+    for (a, b) in exrs[0].iter().zip(&exrs[1]) {
+        assert!((a - b).abs() <= 1e-6);
+    }
+    // A curved planet and bad knobs.
+    let out = dir.path().join("moon.exr");
+    expect_code(
+        &bake(
+            dir.path(),
+            &[
+                "softshadow",
+                s(&wall),
+                "--sun-azimuth",
+                "90",
+                "--sun-elevation",
+                "2",
+                "--planet-radius",
+                "1737400",
+                "--out",
+                s(&out),
+                "-q",
+            ],
+        ),
+        0,
+    );
+    for (args, code) in [
+        (vec!["--sun-radius", "0"], exit::INPUT),
+        (vec!["--planet-radius", "0"], exit::INPUT),
+        (vec!["--method", "uniform", "--steps", "0"], exit::USAGE),
+    ] {
+        let mut all = vec![
+            "softshadow",
+            s(&wall),
+            "--sun-azimuth",
+            "90",
+            "--sun-elevation",
+            "2",
+            "--out",
+            "x.exr",
+        ];
+        all.extend_from_slice(&args);
+        expect_code(&bake(dir.path(), &all), code);
+    }
+    assert!(!dir.path().join("x.exr").exists());
+}

@@ -49,6 +49,8 @@ pub struct MinMaxMipmap {
     pub data: Vec<f32>,
     /// The largest height of the map (the maximum over the coarsest level).
     pub max_height: f32,
+    /// The smallest height of the map (the minimum over the coarsest level).
+    pub min_height: f32,
 }
 
 /// The level sizes for a map: ceil(W/2) × ceil(H/2), then ceil halving, stopping before 1×1
@@ -127,13 +129,14 @@ impl MinMaxMipmap {
                     }
                 });
         }
-        let max_height = top_max(&levels, &data);
+        let (max_height, min_height) = top_max_min(&levels, &data);
         MinMaxMipmap {
             map_width: map.width,
             map_height: map.height,
             levels,
             data,
             max_height,
+            min_height,
         }
     }
 
@@ -270,24 +273,25 @@ impl MinMaxMipmap {
                 data.push(b);
             }
         }
-        let max_height = top_max(&levels, &data);
+        let (max_height, min_height) = top_max_min(&levels, &data);
         Ok(MinMaxMipmap {
             map_width: mw,
             map_height: mh,
             levels,
             data,
             max_height,
+            min_height,
         })
     }
 }
 
-fn top_max(levels: &[MipLevel], data: &[f32]) -> f32 {
+fn top_max_min(levels: &[MipLevel], data: &[f32]) -> (f32, f32) {
     let top = levels.last().expect("level 0 always exists");
     data[2 * top.offset..2 * (top.offset + top.width * top.height)]
-        .iter()
-        .step_by(2)
-        .copied()
-        .fold(f32::NEG_INFINITY, f32::max)
+        .chunks_exact(2)
+        .fold((f32::NEG_INFINITY, f32::INFINITY), |(hi, lo), p| {
+            (hi.max(p[0]), lo.min(p[1]))
+        })
 }
 
 #[cfg(test)]

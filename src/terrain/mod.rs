@@ -4,7 +4,9 @@
 //! - [`exact_traversal`]: hard shadows by visiting every texel on the track (algorithm A1, the reference);
 //! - [`minmax_mipmap`]: the min/max mipmap (the `minmax_mipmap` pipeline stage);
 //! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
+//! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
 //! - [`relief`]: whole-image shadow masks and shaded relief;
+//! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
 //! - [`generate`]: synthetic height maps (stress maps and analytic shapes);
 //! - [`images`]: writing masks and reliefs (PNG/EXR) atomically.
 //!
@@ -14,10 +16,12 @@
 pub mod accelerated_traversal;
 pub mod exact_traversal;
 pub mod generate;
+pub mod hard_f32;
 pub mod images;
 pub mod minmax_mipmap;
 pub mod mipmap_stage;
 pub mod relief;
+pub mod soft;
 pub mod sun;
 
 pub use minmax_mipmap::MinMaxMipmap;

@@ -89,6 +89,9 @@ enum Command {
     /// Hard relief shadows of a height map for one sun: shadow mask and shaded relief (PNG)
     #[command(after_help = EXIT_CODES)]
     Shadow(terrain::ShadowArgs),
+    /// Soft shadows of the sun's disc (penumbrae, curved planets): lit fraction and shaded relief
+    #[command(after_help = EXIT_CODES)]
+    Softshadow(terrain::SoftShadowArgs),
     /// Write a synthetic height map: stress maps (spikes, steps) and analytic shapes
     Generate(terrain::GenerateArgs),
     /// Load a scene (.obj .gltf .glb) or height map (.png .jpg .exr .tif .raw) and summarise it
@@ -255,6 +258,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         Command::Radiosity(c) => radiosity::run(c, json, cli.global.quiet, ui),
         Command::Compress(c) => compress::run(c, ui, json, cli.global.quiet),
         Command::Shadow(a) => terrain::shadow(a, ui, cli.global.quiet, json),
+        Command::Softshadow(a) => terrain::softshadow(a, ui, cli.global.quiet, json),
         Command::Generate(a) => terrain::generate_cmd(a, cli.global.quiet, json),
         Command::Load { file, knobs } => {
             let loaded = load_any(

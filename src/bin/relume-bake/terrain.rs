@@ -9,6 +9,7 @@ use relume::progress::Progress;
 use relume::terrain::generate::{generate, quantise_u16, Shape};
 use relume::terrain::images::{self, check_extension};
 use relume::terrain::relief::{self, HardMethod};
+use relume::terrain::soft::{soft_shadow_map, SoftMethod, SoftShadowParams};
 use relume::terrain::Sun;
 use relume::{Error, Result};
 use serde_json::json;
@@ -104,6 +105,139 @@ pub struct GenerateArgs {
     /// Output: .exr (f32 metres) or .png (16-bit; prints the height scale to load it with)
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum SoftMethodArg {
+    /// Every texel on the track (the reference; slow at low sun)
+    Exhaustive,
+    /// --steps evenly spaced samples (the seed's baseline)
+    Uniform,
+    /// The seed's dynamic programming over the mipmap (--start-level, --intervals)
+    DynamicProgramming,
+    /// The exact answer by branch-and-bound over the mipmap
+    BranchAndBound,
+}
+
+#[derive(Args)]
+#[command(after_help = SUN_HELP)]
+pub struct SoftShadowArgs {
+    #[command(flatten)]
+    pub map: MapArgs,
+    #[command(flatten)]
+    pub sun: SunArgs,
+    /// Angular radius of the sun disc in degrees (the Sun: 0.2666)
+    #[arg(long, value_name = "DEG", default_value_t = 0.2666)]
+    pub sun_radius: f64,
+    /// Planet radius in metres for curved terrain (Moon 1737400, Earth 6371000); default flat
+    #[arg(long, value_name = "M")]
+    pub planet_radius: Option<f64>,
+    /// How the most occluding point is found
+    #[arg(long, value_enum, default_value_t = SoftMethodArg::BranchAndBound)]
+    pub method: SoftMethodArg,
+    /// Uniform: number of samples along the track
+    #[arg(long, value_name = "N", default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..))]
+    pub steps: u32,
+    /// Dynamic programming: mipmap level to start from (-1 = texels; clamped to the top)
+    #[arg(
+        long,
+        value_name = "L",
+        default_value_t = 4,
+        allow_hyphen_values = true
+    )]
+    pub start_level: i32,
+    /// Dynamic programming: intervals along the track (0 = as many as it needs)
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub intervals: u32,
+    /// Lit fraction to write: .png (16-bit, 65535 = fully lit) or .exr (f32)
+    #[arg(long, value_name = "LIT.png|LIT.exr")]
+    pub out: PathBuf,
+    /// Also write a shaded relief (.png, sRGB): Lambert × (k_shadow + (1 − k_shadow)·lit)
+    #[arg(long, value_name = "RELIEF.png")]
+    pub shaded: Option<PathBuf>,
+    /// Shadow brightness with the sun on the horizon
+    #[arg(long, default_value_t = 0.2, value_name = "K")]
+    pub k_dark: f64,
+    /// Shadow brightness with the sun at the zenith
+    #[arg(long, default_value_t = 0.6, value_name = "K")]
+    pub k_bright: f64,
+}
+
+/// `relume-bake softshadow`.
+pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
+    let sun = Sun::new(args.sun.sun_azimuth, args.sun.sun_elevation)?;
+    relief::check_k(args.k_dark, args.k_bright)?;
+    check_extension(&args.out, &["png", "exr"])?;
+    if let Some(s) = &args.shaded {
+        check_extension(s, &["png"])?;
+    }
+    let method = match args.method {
+        SoftMethodArg::Exhaustive => SoftMethod::Exhaustive,
+        SoftMethodArg::Uniform => SoftMethod::Uniform { steps: args.steps },
+        SoftMethodArg::DynamicProgramming => SoftMethod::DynamicProgramming {
+            start_level: args.start_level,
+            intervals: args.intervals,
+        },
+        SoftMethodArg::BranchAndBound => SoftMethod::BranchAndBound,
+    };
+    let params = SoftShadowParams {
+        sun_radius_deg: args.sun_radius,
+        planet_radius_m: args.planet_radius,
+        method,
+    };
+    params.check()?;
+    ui.begin("load", 0);
+    let map = load_map(&args.map)?;
+    ui.finish();
+    let t0 = Instant::now();
+    let lit = soft_shadow_map(&map, &sun, &params, None, ui)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    if images::is_exr(&args.out) {
+        images::write_exr_gray(&args.out, map.width, map.height, &lit)?;
+    } else {
+        let px = lit
+            .iter()
+            .map(|&l| (l.clamp(0.0, 1.0) * 65535.0).round() as u16)
+            .collect();
+        images::write_png_gray16(&args.out, map.width, map.height, px)?;
+    }
+    if let Some(path) = &args.shaded {
+        let shadow: Vec<f32> = lit.iter().map(|l| 1.0 - l).collect();
+        let relief = relief::shaded_relief(&map, &sun, &shadow, args.k_dark, args.k_bright);
+        let px = relief.into_iter().map(images::linear_to_srgb8).collect();
+        images::write_png_gray8(path, map.width, map.height, px)?;
+    }
+    let n = lit.len() as f64;
+    let mean = lit.iter().map(|&l| l as f64).sum::<f64>() / n;
+    let penumbra = lit.iter().filter(|&&l| l > 0.0 && l < 1.0).count() as f64 / n;
+    let mpix = n / seconds.max(1e-9) / 1e6;
+    if json {
+        print_json(&json!({
+            "input": args.map.input.display().to_string(),
+            "width": map.width, "height": map.height,
+            "cell_size": map.cell_size, "height_scale": map.height_scale,
+            "sun_azimuth": sun.azimuth_deg, "sun_elevation": sun.elevation_deg,
+            "sun_radius": args.sun_radius, "planet_radius": args.planet_radius,
+            "method": method.label(),
+            "mean_lit": mean, "penumbra_fraction": penumbra,
+            "seconds": seconds, "mpixels_per_second": mpix,
+            "out": args.out.display().to_string(),
+            "shaded": args.shaded.as_ref().map(|p| p.display().to_string()),
+        }));
+    } else if !quiet {
+        eprintln!(
+            "{}x{} ({}): mean lit {:.3}, {:.1} % in penumbra, {:.3} s ({:.1} Mpixel/s) → {}",
+            map.width,
+            map.height,
+            method.label(),
+            mean,
+            100.0 * penumbra,
+            seconds,
+            mpix,
+            args.out.display()
+        );
+    }
+    Ok(exit::OK)
 }
 
 /// Load the input of a terrain command: a height map, or a pipeline's height-map input.
