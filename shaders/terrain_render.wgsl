@@ -1,7 +1,8 @@
 // Terrain frame: the height field as a grid mesh (x east = column · cell_x, y up = height,
 // z south = row · cell_y), shaded per pixel at the pixel's texel: hypsometric tint × (Lambert ×
 // shadow brightness + sky), relief shadows by the accelerated traversal (hard), aerial
-// perspective, tone map. Rust twin: relume::render::terrain_shading.
+// perspective, tone map; soft shadows (the sun disc's lit fraction by branch-and-bound) on
+// request. Rust twin: relume::render::terrain_shading.
 //! include terrain_shadow.wgsl
 
 struct TerrainFrame {
@@ -11,7 +12,7 @@ struct TerrainFrame {
     cell: vec4<f32>,           // cell_x, cell_y, vertical exaggeration, grid step (texels)
     fog: vec4<f32>,            // extinction per metre, scattering albedo, anisotropy g, sun strength
     exposure: f32,
-    flags: u32,                // bit 0 shadows, bit 1 fog
+    flags: u32,                // bit 0 shadows, bit 1 fog, bit 2 soft shadows
     min_height: f32,
     max_height_tint: f32,
 }
@@ -91,8 +92,12 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
     let col = clamp(i32(floor(v.texel.x)), 0, i32(terrain.width) - 1);
     let row = clamp(i32(floor(v.texel.y)), 0, i32(terrain.height) - 1);
     var shadow = 0.0;
-    if ((frame.flags & 1u) != 0u && shadowed_accelerated(col, row)) {
-        shadow = 1.0;
+    if ((frame.flags & 1u) != 0u) {
+        if ((frame.flags & 4u) != 0u) {
+            shadow = 1.0 - lit_branch_and_bound(col, row);
+        } else if (shadowed_accelerated(col, row)) {
+            shadow = 1.0;
+        }
     }
     var rgb = texel_radiance(height_at(col, row), lambert_at(col, row), shadow, frame.sun.w);
     if ((frame.flags & 2u) != 0u) {

@@ -93,7 +93,9 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     dense_player.render(&gpu, &camera, &s, &mut timer).unwrap();
     let (shape, transport) = relume::baked::read_npy_f32(&dir.join("transport.npy")).unwrap();
     let b_dense = gather_dense(&transport, shape[0] as usize, n, &e);
-    let Player::Mesh(m) = &dense_player;
+    let Player::Mesh(m) = &dense_player else {
+        panic!("a mesh bake")
+    };
     let rt = &m.radiosity.as_ref().expect("the bake has a transport").1;
     // Same f32 summation order; lavapipe may fuse multiply-adds: a few ulp of the largest value.
     rel_close(
@@ -114,7 +116,9 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
         .map(|i| [b_flat[i], b_flat[n + i], b_flat[2 * n + i]])
         .collect();
     let corners = corner_indirect(&set, &b);
-    let Player::Mesh(m) = &player;
+    let Player::Mesh(m) = &player else {
+        panic!("a mesh bake")
+    };
     let rt = &m.radiosity.as_ref().expect("the bake has a transport").1;
     let e_gpu = flat(&readback::read_f32(&gpu, &rt.exitance).unwrap());
     rel_close(&e_gpu[..3 * n], &e.concat(), 1e-6, "direct exitance");
@@ -208,7 +212,9 @@ fn punctual_lights_with_shadow_maps_match_ray_traced_shadows() {
     let mut timer = relume::gpu::timing::PassTimer::new(&gpu, 48);
     player.render(&gpu, &camera, &s, &mut timer).unwrap();
     let gpu_img = player.read_image(&gpu).unwrap();
-    let Player::Mesh(m) = &player;
+    let Player::Mesh(m) = &player else {
+        panic!("a mesh bake")
+    };
     let lights = m.renderer.lights_uniform();
     let lights = &lights.lights[..lights.count as usize];
     assert_eq!(
@@ -238,4 +244,89 @@ fn punctual_lights_with_shadow_maps_match_ray_traced_shadows() {
     let unshadowed = player.read_image(&gpu).unwrap();
     let (diff, _) = compare(&gpu_img, &unshadowed, 24);
     assert!(diff > 1.0, "shadows make no difference ({diff})");
+}
+
+#[test]
+fn player_cli_writes_frames_and_timings_and_reports_bad_input() {
+    if gpu().is_none() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = bake_pipeline(tmp.path(), "pipelines/cornell.ron");
+    let out = tmp.path().join("frames");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[
+        dir.to_str().unwrap(),
+        "--headless",
+        "--frames",
+        "3",
+        "--size",
+        "96x72",
+        "--sun",
+        "10,20",
+        "-q",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::text(&o));
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("frames.json")).unwrap()).unwrap();
+    let frames = j["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 3);
+    for f in frames {
+        assert!(f["cpu_ms"].as_f64().unwrap() > 0.0);
+        if j["adapter"]["timestamps"] == true {
+            let passes: Vec<&str> = f["gpu_ms"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| p[0].as_str().unwrap())
+                .collect();
+            for want in ["shadow maps", "direct", "gather", "transfer", "shade"] {
+                assert!(passes.contains(&want), "pass {want} missing in {passes:?}");
+            }
+        }
+    }
+    for k in 0..3 {
+        assert!(out.join(format!("frame_{k:04}.png")).is_file());
+    }
+    // Both gather paths and the dense reference are selectable from the command line.
+    for extra in [
+        ["--bc-decode", "shader"],
+        ["--bc-decode", "hardware"],
+        ["--transport", "dense"],
+    ] {
+        let o = run(&[
+            dir.to_str().unwrap(),
+            "--headless",
+            "--size",
+            "32x24",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+            extra[0],
+            extra[1],
+        ]);
+        assert!(o.status.success(), "{extra:?}: {}", common::text(&o));
+    }
+    // Not a bake: exit 3 naming the path; a bad --size: usage error 2.
+    let o = run(&[
+        tmp.path().to_str().unwrap(),
+        "--headless",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(4), "{}", common::text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("manifest"),
+        "{}",
+        common::text(&o)
+    );
+    let o = run(&[dir.to_str().unwrap(), "--headless", "--size", "0x10"]);
+    assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
 }

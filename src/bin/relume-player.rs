@@ -64,6 +64,12 @@ struct Cli {
     /// Leave out shadows
     #[arg(long)]
     no_shadows: bool,
+    /// Terrain: soft shadows of the sun's disc (branch-and-bound) instead of hard ones
+    #[arg(long)]
+    soft: bool,
+    /// Terrain: no aerial perspective
+    #[arg(long)]
+    no_fog: bool,
     /// Transport to gather from: the encoded one when the bake has it (auto), or the dense
     /// `transport.npy` reference
     #[arg(long, value_enum, default_value_t = TransportArg::Auto)]
@@ -184,6 +190,8 @@ fn settings(cli: &Cli) -> FrameSettings {
         direct: !cli.no_direct,
         indirect: !cli.no_indirect,
         shadows: !cli.no_shadows,
+        soft_shadows: cli.soft,
+        fog: !cli.no_fog,
         ..Default::default()
     }
 }

@@ -10,8 +10,8 @@ pub mod compressed_gather;
 pub mod compute;
 pub mod mesh_renderer;
 pub mod radiosity_runtime;
-pub mod terrain_renderer;
 pub mod readback;
+pub mod terrain_renderer;
 pub mod timing;
 
 use crate::error::{Error, Result};

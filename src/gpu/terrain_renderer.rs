@@ -28,7 +28,18 @@ struct TerrainParams {
     inv_uy: f32,
     rise_per_t: f32,
     max_height: f32,
-    pad1: [u32; 2],
+    min_height: f32,
+    metres_per_t: f32,
+    alpha: f32,
+    planet_radius: f32,
+    sin_elevation0: f32,
+    cos_elevation0: f32,
+    sin_azimuth: f32,
+    cos_azimuth: f32,
+    cell_x: f32,
+    cell_y: f32,
+    tan_alpha: f32,
+    pad1: [u32; 3],
 }
 
 #[repr(C)]
@@ -77,7 +88,14 @@ pub const MAX_GRID: u32 = 1024;
 impl TerrainRenderer {
     /// Upload `map` and `mip` and create a `width`×`height` target. `grid_step` None picks the
     /// display-mesh decimation so that at most [`MAX_GRID`] vertices span a side.
-    pub fn new(gpu: &Gpu, map: &HeightMap, mip: &MinMaxMipmap, width: u32, height: u32, grid_step: Option<u32>) -> Result<Self> {
+    pub fn new(
+        gpu: &Gpu,
+        map: &HeightMap,
+        mip: &MinMaxMipmap,
+        width: u32,
+        height: u32,
+        grid_step: Option<u32>,
+    ) -> Result<Self> {
         if (mip.map_width, mip.map_height) != (map.width, map.height) {
             return Err(Error::Internal("mipmap and height map sizes differ".into()));
         }
@@ -93,19 +111,40 @@ impl TerrainRenderer {
         }
         let heights = compute::storage(gpu, "heights", &map.heights);
         let mip_data = compute::storage(gpu, "minmax mipmap", &mip.data);
-        let levels: Vec<[u32; 4]> = mip.levels.iter().map(|l| [l.width as u32, l.height as u32, l.offset as u32, 0]).collect();
+        let levels: Vec<[u32; 4]> = mip
+            .levels
+            .iter()
+            .map(|l| [l.width as u32, l.height as u32, l.offset as u32, 0])
+            .collect();
         let mip_levels = compute::storage(gpu, "mip levels", &levels);
-        let params_cpu = TerrainParams { width: map.width as u32, height: map.height as u32, levels: mip.levels.len() as u32, ..Default::default() };
+        let params_cpu = TerrainParams {
+            width: map.width as u32,
+            height: map.height as u32,
+            levels: mip.levels.len() as u32,
+            ..Default::default()
+        };
         let params = compute::uniform(gpu, "terrain params", &params_cpu);
         let terrain_entries = |layout: &wgpu::BindGroupLayout| {
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("terrain"),
                 layout,
                 entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: heights.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: mip_data.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: mip_levels.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: heights.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: mip_data.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: mip_levels.as_entire_binding(),
+                    },
                 ],
             })
         };
@@ -113,41 +152,60 @@ impl TerrainRenderer {
         let mask_pipeline = compute::pipeline(gpu, "terrain_mask.wgsl", "main")?;
         let mask_params = compute::uniform(gpu, "mask params", &[0u32; 4]);
         let mask_out = compute::output(gpu, "mask", (map.width * map.height * 4) as u64);
-        let mask_group0 = compute::bind(gpu, &mask_pipeline, &[mask_params.as_entire_binding(), mask_out.as_entire_binding()]);
-        let mask_groups = [mask_group0, terrain_entries(&mask_pipeline.get_bind_group_layout(1))];
+        let mask_group0 = compute::bind(
+            gpu,
+            &mask_pipeline,
+            &[
+                mask_params.as_entire_binding(),
+                mask_out.as_entire_binding(),
+            ],
+        );
+        let mask_groups = [
+            mask_group0,
+            terrain_entries(&mask_pipeline.get_bind_group_layout(1)),
+        ];
 
         let module = gpu.shader("terrain_render.wgsl")?;
-        let render_pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("terrain"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 8,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 0, shader_location: 0 }],
-                })],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(super::mesh_renderer::TARGET_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let render_pipeline = gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("terrain"),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: 8,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &[wgpu::VertexAttribute {
+                            format: wgpu::VertexFormat::Float32x2,
+                            offset: 0,
+                            shader_location: 0,
+                        }],
+                    })],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: wgpu::TextureFormat::Depth32Float,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(super::mesh_renderer::TARGET_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
         let frame = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("terrain frame"),
             size: std::mem::size_of::<TerrainFrame>() as u64,
@@ -157,12 +215,21 @@ impl TerrainRenderer {
         let g0 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("terrain frame"),
             layout: &render_pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() }],
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: frame.as_entire_binding(),
+            }],
         });
-        let render_groups = [g0, terrain_entries(&render_pipeline.get_bind_group_layout(1))];
+        let render_groups = [
+            g0,
+            terrain_entries(&render_pipeline.get_bind_group_layout(1)),
+        ];
 
-        let step = grid_step.unwrap_or_else(|| (map.width.max(map.height) as u32).div_ceil(MAX_GRID)).max(1);
-        let (grid, indices, index_count) = grid_mesh(gpu, map.width as u32, map.height as u32, step);
+        let step = grid_step
+            .unwrap_or_else(|| (map.width.max(map.height) as u32).div_ceil(MAX_GRID))
+            .max(1);
+        let (grid, indices, index_count) =
+            grid_mesh(gpu, map.width as u32, map.height as u32, step);
         let (target, target_view, depth_view) = super::mesh_renderer::targets(gpu, width, height);
         let (lo, hi) = map.min_max();
         let mut r = TerrainRenderer {
@@ -190,6 +257,10 @@ impl TerrainRenderer {
             sun: Sun::new(135.0, 30.0)?,
         };
         r.params_cpu.max_height = mip.max_height;
+        r.params_cpu.min_height = mip.min_height;
+        r.params_cpu.cell_x = r.cell[0];
+        r.params_cpu.cell_y = r.cell[1];
+        r.set_soft(gpu, crate::terrain::soft::model::SUN_RADIUS_DEG, None);
         r.set_sun(gpu, Sun::new(135.0, 30.0)?);
         Ok(r)
     }
@@ -210,13 +281,50 @@ impl TerrainRenderer {
         p.inv_ux = t.inv_ux as f32;
         p.inv_uy = t.inv_uy as f32;
         p.rise_per_t = t.rise_per_t as f32;
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(p));
+        p.metres_per_t = t.metres_per_t as f32;
+        let (se, ce) = sun.elevation_deg.to_radians().sin_cos();
+        (p.sin_elevation0, p.cos_elevation0) = (se as f32, ce as f32);
+        let (sa, ca) = sun.azimuth_deg.to_radians().sin_cos();
+        (p.sin_azimuth, p.cos_azimuth) = (sa as f32, ca as f32);
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(p));
         self.sun = sun;
+    }
+
+    /// Soft-shadow knobs: the sun's angular radius (degrees) and the planet radius (metres,
+    /// None = flat ground).
+    pub fn set_soft(&mut self, gpu: &Gpu, sun_radius_deg: f64, planet_radius_m: Option<f64>) {
+        self.params_cpu.alpha = sun_radius_deg.to_radians() as f32;
+        self.params_cpu.tan_alpha = sun_radius_deg.to_radians().tan() as f32;
+        self.params_cpu.planet_radius = planet_radius_m.unwrap_or(0.0) as f32;
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&self.params_cpu));
     }
 
     /// The hard-shadow mask of every texel (row-major, true = shadow), computed on the GPU.
     pub fn shadow_mask(&self, gpu: &Gpu, accelerated: bool) -> Result<Vec<bool>> {
-        gpu.queue.write_buffer(&self.mask_params, 0, bytemuck::cast_slice(&[accelerated as u32, 0, 0, 0]));
+        Ok(self
+            .run_mask(gpu, accelerated as u32)?
+            .iter()
+            .map(|&w| w != 0)
+            .collect())
+    }
+
+    /// The soft lit fraction of every texel (row-major), by branch-and-bound on the GPU.
+    pub fn lit_fraction(&self, gpu: &Gpu) -> Result<Vec<f32>> {
+        Ok(self
+            .run_mask(gpu, 2)?
+            .iter()
+            .map(|&w| f32::from_bits(w))
+            .collect())
+    }
+
+    fn run_mask(&self, gpu: &Gpu, method: u32) -> Result<Vec<u32>> {
+        gpu.queue.write_buffer(
+            &self.mask_params,
+            0,
+            bytemuck::cast_slice(&[method, 0, 0, 0]),
+        );
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -228,35 +336,62 @@ impl TerrainRenderer {
         gpu.queue.submit([enc.finish()]);
         let words = super::readback::read_buffer(gpu, &self.mask_out)?;
         let words: &[u32] = bytemuck::cast_slice(&words);
-        Ok(words[..(self.map_size.0 * self.map_size.1) as usize].iter().map(|&w| w != 0).collect())
+        Ok(words[..(self.map_size.0 * self.map_size.1) as usize].to_vec())
     }
 
-    /// A camera over the map from the south-east, looking at its centre (world: x east, y up,
+    /// A camera over the map from the south, looking at its centre (world: x east, y up,
     /// z south; vertical exaggeration from `s`).
     pub fn default_view(&self, s: &TerrainSettings) -> (Vec3, Vec3) {
         let w = self.map_size.0 as f32 * self.cell[0];
         let d = self.map_size.1 as f32 * self.cell[1];
-        let centre = Vec3::new(0.5 * w, self.heights_range.0 * s.vertical_exaggeration, 0.5 * d);
+        let centre = Vec3::new(
+            0.5 * w,
+            self.heights_range.0 * s.vertical_exaggeration,
+            0.5 * d,
+        );
         let size = w.max(d);
-        (centre + Vec3::new(0.35 * size, 0.55 * size, 0.85 * size), centre)
+        (
+            centre + Vec3::new(0.1 * size, 0.38 * size, 0.72 * size),
+            centre,
+        )
     }
 
     /// Record the terrain frame for `view_proj` seen from `eye`.
-    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, view_proj: Mat4, eye: Vec3, s: &TerrainSettings, timer: &mut PassTimer) {
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        view_proj: Mat4,
+        eye: Vec3,
+        s: &TerrainSettings,
+        timer: &mut PassTimer,
+    ) {
         let dir = self.sun.direction();
-        let k = crate::terrain::relief::k_shadow(&self.sun, s.k_dark as f64, s.k_bright as f64) as f32;
+        let k =
+            crate::terrain::relief::k_shadow(&self.sun, s.k_dark as f64, s.k_bright as f64) as f32;
         let f = TerrainFrame {
             view_proj: view_proj.to_cols_array(),
             eye: eye.extend(1.0).to_array(),
             sun: [dir[0] as f32, dir[1] as f32, dir[2] as f32, k],
-            cell: [self.cell[0], self.cell[1], s.vertical_exaggeration, self.grid_step as f32],
-            fog: [s.fog_extinction, s.fog_albedo, s.fog_anisotropy, s.sun_strength],
+            cell: [
+                self.cell[0],
+                self.cell[1],
+                s.vertical_exaggeration,
+                self.grid_step as f32,
+            ],
+            fog: [
+                s.fog_extinction,
+                s.fog_albedo,
+                s.fog_anisotropy,
+                s.sun_strength,
+            ],
             exposure: s.exposure,
-            flags: s.shadows as u32 | (s.fog as u32) << 1,
+            flags: s.shadows as u32 | (s.fog as u32) << 1 | (s.soft as u32) << 2,
             min_height: self.heights_range.0,
             max_height_tint: self.heights_range.1,
         };
-        gpu.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
+        gpu.queue
+            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
         let bg = s.background;
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("terrain"),
@@ -265,13 +400,21 @@ impl TerrainRenderer {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r: bg[0] as f64, g: bg[1] as f64, b: bg[2] as f64, a: 1.0 }),
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: bg[0] as f64,
+                        g: bg[1] as f64,
+                        b: bg[2] as f64,
+                        a: 1.0,
+                    }),
                     store: wgpu::StoreOp::Store,
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
                 stencil_ops: None,
             }),
             timestamp_writes: timer.render("terrain"),
@@ -298,13 +441,17 @@ impl TerrainRenderer {
 
     pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
         let px = super::readback::read_texture_4bpp(gpu, &self.target)?;
-        image::RgbaImage::from_raw(self.width, self.height, px).ok_or_else(|| Error::Internal("readback size".into()))
+        image::RgbaImage::from_raw(self.width, self.height, px)
+            .ok_or_else(|| Error::Internal("readback size".into()))
     }
 
     /// The top-down orthographic view in which pixel (x, y) of a map-sized image sees the
     /// centre of texel (x, y) (north up): the map view of the twin test.
     pub fn map_view(&self) -> (Mat4, Vec3) {
-        let (w, h) = (self.map_size.0 as f32 * self.cell[0], self.map_size.1 as f32 * self.cell[1]);
+        let (w, h) = (
+            self.map_size.0 as f32 * self.cell[0],
+            self.map_size.1 as f32 * self.cell[1],
+        );
         let top = self.heights_range.1.abs().max(self.heights_range.0.abs()) * 4.0 + 1.0;
         let eye = Vec3::new(0.0, top, 0.0);
         // Looking down −y with north (−z) up in the image.
@@ -325,7 +472,10 @@ fn grid_mesh(gpu: &Gpu, w: u32, h: u32, step: u32) -> (wgpu::Buffer, wgpu::Buffe
         v
     };
     let (xs, ys) = (axis(w), axis(h));
-    let verts: Vec<[f32; 2]> = ys.iter().flat_map(|&y| xs.iter().map(move |&x| [x as f32 + 0.5, y as f32 + 0.5])).collect();
+    let verts: Vec<[f32; 2]> = ys
+        .iter()
+        .flat_map(|&y| xs.iter().map(move |&x| [x as f32 + 0.5, y as f32 + 0.5]))
+        .collect();
     let nx = xs.len() as u32;
     let mut idx = Vec::new();
     for j in 0..ys.len() as u32 - 1 {
@@ -338,15 +488,19 @@ fn grid_mesh(gpu: &Gpu, w: u32, h: u32, step: u32) -> (wgpu::Buffer, wgpu::Buffe
         // A one-texel-wide map: a degenerate strip still draws nothing; keep the buffer valid.
         idx.extend_from_slice(&[0, 0, 0]);
     }
-    let vb = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("terrain grid"),
-        contents: bytemuck::cast_slice(&verts),
-        usage: wgpu::BufferUsages::VERTEX,
-    });
-    let ib = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("terrain indices"),
-        contents: bytemuck::cast_slice(&idx),
-        usage: wgpu::BufferUsages::INDEX,
-    });
+    let vb = gpu
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("terrain grid"),
+            contents: bytemuck::cast_slice(&verts),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+    let ib = gpu
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("terrain indices"),
+            contents: bytemuck::cast_slice(&idx),
+            usage: wgpu::BufferUsages::INDEX,
+        });
     (vb, ib, idx.len() as u32)
 }

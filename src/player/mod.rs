@@ -2,8 +2,10 @@
 //! (`relume-player`) only parses arguments and runs the window or headless loop around this.
 
 mod mesh;
+mod terrain;
 
 pub use mesh::MeshPlayer;
+pub use terrain::TerrainPlayer;
 
 use crate::baked::Manifest;
 use crate::error::Result;
@@ -56,6 +58,7 @@ pub struct PlayerOptions {
 /// What every loaded bake can do each frame.
 pub enum Player {
     Mesh(Box<MeshPlayer>),
+    Terrain(Box<TerrainPlayer>),
 }
 
 /// Wall and GPU times of one frame.
@@ -82,10 +85,9 @@ impl Player {
             "scene" => Ok(Player::Mesh(Box::new(MeshPlayer::load(
                 gpu, dir, &manifest, opts, width, height,
             )?))),
-            other => Err(crate::error::Error::unsupported(
-                dir,
-                format!("the player cannot render {other} bakes yet"),
-            )),
+            _ => Ok(Player::Terrain(Box::new(TerrainPlayer::load(
+                gpu, dir, &manifest, width, height,
+            )?))),
         }
     }
 
@@ -93,6 +95,7 @@ impl Player {
     pub fn default_camera(&self) -> Camera {
         match self {
             Player::Mesh(m) => m.default_camera(),
+            Player::Terrain(t) => t.default_camera(),
         }
     }
 
@@ -100,6 +103,7 @@ impl Player {
     pub fn set_sun(&mut self, gpu: &Gpu, sun: Option<Sun>) -> Result<()> {
         match self {
             Player::Mesh(m) => m.set_sun(gpu, sun),
+            Player::Terrain(t) => t.set_sun(gpu, sun),
         }
     }
 
@@ -113,6 +117,13 @@ impl Player {
     ) -> Result<()> {
         match self {
             Player::Mesh(m) => m.render(gpu, camera, s, timer),
+            Player::Terrain(t) => {
+                t.settings.exposure = s.exposure;
+                t.settings.shadows = s.shadows;
+                t.settings.soft = s.soft_shadows;
+                t.settings.fog = s.fog;
+                t.render(gpu, camera, timer)
+            }
         }
     }
 
@@ -120,6 +131,7 @@ impl Player {
     pub fn target_view(&self) -> &wgpu::TextureView {
         match self {
             Player::Mesh(m) => m.renderer.target_view(),
+            Player::Terrain(t) => t.renderer.target_view(),
         }
     }
 
@@ -127,6 +139,7 @@ impl Player {
     pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) -> Result<()> {
         match self {
             Player::Mesh(m) => m.renderer.resize(gpu, width, height),
+            Player::Terrain(t) => t.renderer.resize(gpu, width, height),
         }
         Ok(())
     }
@@ -135,6 +148,7 @@ impl Player {
     pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
         match self {
             Player::Mesh(m) => m.renderer.read_image(gpu),
+            Player::Terrain(t) => t.renderer.read_image(gpu),
         }
     }
 }

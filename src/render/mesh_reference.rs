@@ -18,6 +18,10 @@ pub struct FrameSettings {
     pub indirect: bool,
     pub shadows: bool,
     pub emission: bool,
+    /// Terrain: soft shadows of the sun's disc instead of hard ones.
+    pub soft_shadows: bool,
+    /// Terrain: aerial perspective.
+    pub fog: bool,
     /// Display colour behind the scene (sRGB, 0..1).
     pub background: [f32; 3],
 }
@@ -31,6 +35,8 @@ impl Default for FrameSettings {
             indirect: true,
             shadows: true,
             emission: true,
+            soft_shadows: false,
+            fog: true,
             background: [0.0; 3],
         }
     }

@@ -3,7 +3,7 @@
 //! brightness k_shadow) and the same tone map, evaluated per texel — what the GPU shows in the
 //! top-down map view, pixel for texel.
 
-use super::tonemap::{tonemap, to_u8};
+use super::tonemap::{to_u8, tonemap};
 use crate::heightmap::HeightMap;
 use crate::terrain::relief::{k_shadow, lambert};
 use crate::terrain::sun::Sun;
@@ -19,6 +19,8 @@ pub struct TerrainSettings {
     /// Multiplies heights for display (1 = true scale).
     pub vertical_exaggeration: f32,
     pub shadows: bool,
+    /// Soft shadows of the sun's disc (branch-and-bound) instead of hard ones.
+    pub soft: bool,
     /// Aerial perspective (seed 001's scattered light), per pixel.
     pub fog: bool,
     /// Extinction β_ext per metre.
@@ -38,12 +40,13 @@ impl Default for TerrainSettings {
             exposure: 1.5,
             k_dark: 0.25,
             k_bright: 0.6,
-            vertical_exaggeration: 2.0,
+            vertical_exaggeration: 3.0,
             shadows: true,
+            soft: false,
             fog: true,
-            fog_extinction: 1.0 / 120_000.0,
-            fog_albedo: 0.8,
-            fog_anisotropy: 0.6,
+            fog_extinction: 2.5e-6,
+            fog_albedo: 0.6,
+            fog_anisotropy: 0.3,
             sun_strength: 1.0,
             background: [0.55, 0.65, 0.8],
         }
@@ -72,7 +75,12 @@ pub fn texel_radiance(s: &TerrainSettings, t: f32, lambert: f32, shadow: f32, k:
 
 /// The map view (one pixel per texel, north up, no fog) of `map` under `sun` with per-texel
 /// shadowed fraction `shadow` (1 = hard shadow).
-pub fn map_view(map: &HeightMap, sun: &Sun, shadow: &[f32], s: &TerrainSettings) -> image::RgbaImage {
+pub fn map_view(
+    map: &HeightMap,
+    sun: &Sun,
+    shadow: &[f32],
+    s: &TerrainSettings,
+) -> image::RgbaImage {
     let lam = lambert(map, sun);
     let k = k_shadow(sun, s.k_dark as f64, s.k_bright as f64) as f32;
     let (lo, hi) = map.min_max();

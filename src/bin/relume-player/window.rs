@@ -255,6 +255,8 @@ impl App {
                 "2" => self.settings.indirect = !self.settings.indirect,
                 "3" => self.settings.shadows = !self.settings.shadows,
                 "4" => self.settings.emission = !self.settings.emission,
+                "5" => self.settings.soft_shadows = !self.settings.soft_shadows,
+                "6" => self.settings.fog = !self.settings.fog,
                 "[" => self.settings.exposure /= 1.25,
                 "]" => self.settings.exposure *= 1.25,
                 _ => {}

@@ -1,0 +1,88 @@
+//! Height-map bakes at runtime: the height field as a mesh with per-pixel relief shadows (hard
+//! by the accelerated traversal, or soft by branch-and-bound) over the min/max mipmap, shadow
+//! brightness k_shadow, aerial perspective; the sun moves freely.
+
+use super::Sun as PlayerSun;
+use crate::baked::{read_heightmap, Manifest};
+use crate::error::Result;
+use crate::gpu::terrain_renderer::TerrainRenderer;
+use crate::gpu::timing::PassTimer;
+use crate::gpu::Gpu;
+use crate::heightmap::HeightMap;
+use crate::render::camera::Camera;
+use crate::render::terrain_shading::TerrainSettings;
+use crate::terrain::mipmap_stage::MIPMAP_FILE;
+use crate::terrain::sun::Sun;
+use crate::terrain::MinMaxMipmap;
+use std::path::Path;
+
+/// A loaded height-map bake.
+pub struct TerrainPlayer {
+    pub map: HeightMap,
+    pub mip: MinMaxMipmap,
+    pub renderer: TerrainRenderer,
+    pub settings: TerrainSettings,
+}
+
+impl TerrainPlayer {
+    /// Load `heightmap.exr` and `minmax_mipmap.exr` (built here when the bake has none).
+    pub fn load(
+        gpu: &Gpu,
+        dir: &Path,
+        manifest: &Manifest,
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
+        let map = read_heightmap(dir, manifest)?;
+        let mip = if manifest.file(MIPMAP_FILE).is_some() {
+            MinMaxMipmap::read_exr(&dir.join(MIPMAP_FILE))?
+        } else {
+            MinMaxMipmap::build(&map)
+        };
+        let renderer = TerrainRenderer::new(gpu, &map, &mip, width, height, None)?;
+        Ok(TerrainPlayer {
+            map,
+            mip,
+            renderer,
+            settings: TerrainSettings::default(),
+        })
+    }
+
+    /// A camera over the map from the south-east, looking at its centre.
+    pub fn default_camera(&self) -> Camera {
+        let (eye, target) = self.renderer.default_view(&self.settings);
+        let d = (eye - target).length();
+        Camera {
+            eye,
+            target,
+            up: glam::Vec3::Y,
+            fov_y_deg: 45.0,
+            near: d * 1e-3,
+            far: d * 10.0,
+        }
+    }
+
+    /// Set the sun (default: azimuth 300°, elevation 10°).
+    pub fn set_sun(&mut self, gpu: &Gpu, sun: Option<PlayerSun>) -> Result<()> {
+        let s = sun.unwrap_or(PlayerSun {
+            azimuth_deg: 300.0,
+            elevation_deg: 10.0,
+        });
+        self.renderer
+            .set_sun(gpu, Sun::new(s.azimuth_deg as f64, s.elevation_deg as f64)?);
+        Ok(())
+    }
+
+    /// Record and submit one frame.
+    pub fn render(&mut self, gpu: &Gpu, camera: &Camera, timer: &mut PassTimer) -> Result<()> {
+        timer.reset();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        let vp = camera.view_projection(self.renderer.width, self.renderer.height);
+        self.renderer
+            .record(gpu, &mut enc, vp, camera.eye, &self.settings, timer);
+        timer.resolve(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait();
+        Ok(())
+    }
+}
