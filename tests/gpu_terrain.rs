@@ -260,7 +260,7 @@ fn player_renders_a_height_map_bake_headless() {
         let j: serde_json::Value =
             serde_json::from_slice(&std::fs::read(out.join("frames.json")).unwrap()).unwrap();
         assert_eq!(j["frames"].as_array().unwrap().len(), 2);
-        assert_eq!(j["adapter"]["name"].as_str().is_some(), true);
+        assert!(j["adapter"]["name"].as_str().is_some());
     }
     // Hard and soft shadows differ; both differ from no shadows.
     let load = |n: &str| {
