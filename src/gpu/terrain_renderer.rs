@@ -83,7 +83,7 @@ pub struct TerrainRenderer {
 }
 
 /// Most grid vertices along a side of the display mesh (the shading is per texel regardless).
-pub const MAX_GRID: u32 = 1024;
+pub const MAX_GRID: u32 = 512;
 
 impl TerrainRenderer {
     /// Upload `map` and `mip` and create a `width`×`height` target. `grid_step` None picks the

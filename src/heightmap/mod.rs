@@ -57,6 +57,9 @@ pub struct HeightMapOptions {
     pub nodata: NoDataPolicy,
     /// Width and height of a raw little-endian f32 file (required for `.raw`/`.f32`).
     pub raw_size: Option<[usize; 2]>,
+    /// Box-filter downsampling factor applied after loading (0 or 1: none).
+    #[serde(default)]
+    pub downsample: u32,
 }
 
 /// Facts about a loaded height map that are not part of the height field itself.
@@ -137,13 +140,16 @@ pub fn load_heightmap(path: &Path, opts: &HeightMapOptions) -> Result<(HeightMap
             nodata_count,
         )?;
     }
-    let map = HeightMap {
+    let mut map = HeightMap {
         width: raw.width,
         height: raw.height,
         heights,
         cell_size,
         height_scale,
     };
+    if opts.downsample > 1 {
+        map = map.downsample(opts.downsample as usize);
+    }
     let info = HeightMapInfo {
         format: raw.format.into(),
         sample: raw.sample.into(),

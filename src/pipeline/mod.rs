@@ -90,6 +90,22 @@ pub struct HeightMapInput {
     /// (width, height) of a raw f32 file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub raw_size: Option<(usize, usize)>,
+    /// Box-filter the map down by this integer factor after loading (2: 4096² → 2048²); the
+    /// cell size grows by the same factor. Default 1.
+    #[serde(
+        default = "one_u32",
+        deserialize_with = "parse::at_least_one",
+        skip_serializing_if = "is_one"
+    )]
+    pub downsample: u32,
+}
+
+fn one_u32() -> u32 {
+    1
+}
+
+fn is_one(v: &u32) -> bool {
+    *v == 1
 }
 
 fn one() -> f32 {
@@ -112,6 +128,7 @@ impl HeightMapInput {
             nodata_value: self.nodata_value,
             nodata: self.nodata,
             raw_size: self.raw_size.map(|(w, h)| [w, h]),
+            downsample: self.downsample,
         }
     }
 }

@@ -122,6 +122,9 @@ struct LoadKnobs {
     /// Height map: extra value (in file units) that marks missing data
     #[arg(long, value_name = "V")]
     nodata_value: Option<f64>,
+    /// Height map: box-filter down by this integer factor after loading (cell size grows)
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    downsample: u32,
     /// Height map: size of a raw little-endian f32 file, WIDTHxHEIGHT
     #[arg(long, value_name = "WxH", value_parser = parse_wxh)]
     raw_size: Option<(usize, usize)>,
@@ -146,6 +149,7 @@ impl LoadKnobs {
                 NoDataArg::FillNearest => NoDataPolicy::FillNearest,
             },
             raw_size: self.raw_size.map(|(w, h)| [w, h]),
+            downsample: self.downsample,
         }
     }
 }
@@ -167,6 +171,7 @@ fn parse_wxh(s: &str) -> std::result::Result<(usize, usize), String> {
 }
 
 fn main() {
+    restore_sigpipe();
     let cli = Cli::parse();
     if let Some(n) = cli.global.threads {
         // Only fails if a pool exists already, which cannot happen this early.
@@ -411,4 +416,14 @@ fn print_json<T: Serialize>(value: &T) {
         "{}",
         serde_json::to_string_pretty(value).expect("report serialises")
     );
+}
+
+/// Die quietly on a closed pipe (`relume-bake inspect DIR | head`) like other Unix tools,
+/// instead of panicking on the failed write.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal disposition to its default before any threads exist.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
 }

@@ -1,0 +1,102 @@
+//! Headless frame times of the player, split by pass (GPU timestamp queries), for the Cornell
+//! box and Puget Sound 2K at 640x480 and 1920x1080. On Mesa's lavapipe/llvmpipe these "GPU"
+//! times are CPU times of a software rasteriser, not GPU times.
+//!
+//! `cargo bench --bench player_frames [-- --frames N]`
+
+use relume::bake::{run_pipeline, BakeOptions};
+use relume::gpu::{timing::PassTimer, Gpu};
+use relume::pipeline::parse_pipeline;
+use relume::player::{Player, PlayerOptions, Sun};
+use relume::render::mesh_reference::FrameSettings;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    v[v.len() / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let frames: usize = args
+        .iter()
+        .position(|a| a == "--frames")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(5);
+    let gpu = match Gpu::new(None) {
+        Ok(g) => g,
+        Err(e) => {
+            eprintln!("SKIP: {e}");
+            return;
+        }
+    };
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tmp = std::env::temp_dir().join(format!("relume-player-bench-{}", std::process::id()));
+    println!(
+        "adapter: {} ({}, {}); median of {frames} frames after one warm-up frame\n",
+        gpu.info.name, gpu.info.backend, gpu.info.device_type
+    );
+    println!("| scene | size | settings | frame wall ms | GPU ms per pass |");
+    println!("|---|---|---|---|---|");
+    for (pipeline, configs) in [
+        (
+            "pipelines/cornell.ron",
+            vec![("emitter + sun, shadows", false)],
+        ),
+        (
+            "pipelines/puget-sound-2k.ron",
+            vec![("hard shadows", false), ("soft shadows", true)],
+        ),
+    ] {
+        let p = parse_pipeline(&root.join(pipeline)).expect("pipeline");
+        let dir = tmp.join(Path::new(pipeline).file_stem().unwrap());
+        run_pipeline(&p, &dir, &BakeOptions::default(), &relume::progress::Silent).expect("bake");
+        for (w, h) in [(640u32, 480u32), (1920, 1080)] {
+            let mut player =
+                Player::load(&gpu, &dir, &PlayerOptions::default(), w, h).expect("load");
+            let camera = player.default_camera();
+            for (label, soft) in &configs {
+                let s = FrameSettings {
+                    soft_shadows: *soft,
+                    exposure: 2.0,
+                    ..Default::default()
+                };
+                let mut timer = PassTimer::new(&gpu, 48);
+                let mut wall = Vec::new();
+                let mut passes: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+                for f in 0..=frames {
+                    let sun = Sun {
+                        azimuth_deg: 300.0 + 10.0 * f as f32,
+                        elevation_deg: 12.0,
+                    };
+                    let t0 = Instant::now();
+                    player.set_sun(&gpu, Some(sun)).unwrap();
+                    player.render(&gpu, &camera, &s, &mut timer).unwrap();
+                    let ms = t0.elapsed().as_secs_f64() * 1e3;
+                    if f > 0 {
+                        wall.push(ms);
+                        for (n, t) in timer.read(&gpu).unwrap() {
+                            passes.entry(n.to_string()).or_default().push(t);
+                        }
+                    }
+                }
+                let per_pass: Vec<String> = passes
+                    .into_iter()
+                    .map(|(n, v)| format!("{n} {:.1}", median(v)))
+                    .collect();
+                println!(
+                    "| {} | {w}x{h} | {label} | {:.1} | {} |",
+                    pipeline
+                        .trim_start_matches("pipelines/")
+                        .trim_end_matches(".ron"),
+                    median(wall),
+                    per_pass.join(", ")
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
