@@ -9,6 +9,7 @@
 
 use rayon::prelude::*;
 use relume::heightmap::HeightMap;
+use relume::study::timing::cpu_seconds;
 use relume::terrain::accelerated_traversal::shadowed_accelerated;
 use relume::terrain::exact_traversal::shadowed_exact;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
@@ -30,24 +31,6 @@ fn puget() -> HeightMap {
     match relume::load::load_input(&p.input).unwrap() {
         relume::load::LoadedInput::HeightMap(m, _) => m,
         _ => unreachable!(),
-    }
-}
-
-/// CPU seconds (user + system) of this process so far, from /proc/self/stat (Linux; 0 elsewhere).
-/// On a shared machine CPU time is a steadier measure than wall time.
-pub fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit_once(')').map(|(_, a)| a).unwrap_or("");
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    // Fields after the command name start at field 3 (state, a letter, is skipped by the
-    // parse): utime and stime are fields 14 and 15, in clock ticks of 1/100 s.
-    if f.len() > 12 {
-        (f[10] + f[11]) / 100.0
-    } else {
-        0.0
     }
 }
 
