@@ -102,8 +102,7 @@ fn plain(text: &str) -> String {
         .replace('²', "^2")
         .replace('·', ".")
         .replace('×', "x")
-        .replace('−', "-")
-        .replace('–', "-")
+        .replace(['−', '–'], "-")
         .replace('µ', "u")
 }
 
@@ -227,13 +226,16 @@ fn tick_label(v: f64) -> String {
     }
 }
 
+/// (x, y, setting label).
+type Point = (f64, f64, String);
+
 /// Draw one plot of `sweep`.
 pub fn draw(spec: &PlotSpec, sweep: &Sweep) -> RgbImage {
     let mut img = RgbImage::from_pixel(WIDTH, HEIGHT, WHITE);
     let (w, h) = (WIDTH as i64, HEIGHT as i64);
     let (x0, x1, y0, y1) = (LEFT, w - RIGHT, TOP, h - BOTTOM);
     // Series in order of first appearance; points with positive finite coordinates.
-    let mut series: Vec<(String, Vec<(f64, f64, String)>)> = Vec::new();
+    let mut series: Vec<(String, Vec<Point>)> = Vec::new();
     let mut skipped = 0;
     for s in &sweep.settings {
         match (s.value(&spec.x), s.value(&spec.y)) {

@@ -9,14 +9,15 @@
 //!
 //! When the soft-shadow methods land (`exhaustive`, `uniform { steps }`,
 //! `dynamic_programming { start_level, intervals }`, `branch_and_bound`), add one function here,
-//! `soft_shadow_sweep(maps: &[(usize, HeightMap, MinMaxMipmap)], cfg, progress) -> Result<Sweep>`,
-//! over the same downsampled maps and mipmaps [`run`] already builds: one [`Setting`] per
-//! (size, elevation, method, steps / start level) with `errors["lit_fraction"]` =
-//! `ErrorStats::of(lit, exhaustive_lit, None)` (mean and max absolute lit fraction against
-//! `exhaustive`, which is the reference row with error exactly 0), `seconds` = the whole-image
-//! time, `baseline` = the `uniform 100` row of the same size and elevation (the ratio),
-//! and the standard `error_plots`. Give [`TerrainConfig`] the swept steps/levels (and quick
-//! values), and push the sweep in [`run`] where the comment marks it. Nothing else (CLI,
+//! `soft_shadow_sweep(maps: &[HeightMap], cfg: &TerrainConfig, progress) -> Result<Sweep>`,
+//! over the downsampled maps [`run`] already builds (`maps`; build each one's `MinMaxMipmap`
+//! once, as the hard-shadow loop does): one [`Setting`] per (size, elevation, method, steps /
+//! start level) with `errors["lit_fraction"]` = `ErrorStats::of(lit, exhaustive_lit, None)`
+//! (mean and max absolute lit fraction against `exhaustive`, which is the reference row, error
+//! exactly 0), `seconds` = the whole-image time, `baseline` = `Some(label of the uniform-100
+//! row of the same size and elevation)` (the ratio), and `sweep.error_plots(...)`.
+//! Give [`TerrainConfig`] the swept steps / levels / elevations (full and quick values) and push
+//! the sweep in [`run`] where the comment marks it. Nothing else (CLI,
 //! report, plots, JSON) needs to change.
 
 use super::timing::{timed, timed_cpu};
