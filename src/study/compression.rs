@@ -284,30 +284,10 @@ pub fn run(
     progress.finish();
     // Passes 0 takes no time: the Linear series starts at its first pass in the plot.
     reorder_sweep.columns = vec![
-        Column::new(
-            "mean abs error",
-            Measure::error("matrix", "mean"),
-            Format::Sci,
-            false,
-        ),
-        Column::new(
-            "max abs error",
-            Measure::error("matrix", "max"),
-            Format::Sci,
-            false,
-        ),
-        Column::new(
-            "summed abs error",
-            Measure::error("matrix", "sum"),
-            Format::Sci,
-            true,
-        ),
-        Column::new(
-            &format!("gather rms rel ({primary})"),
-            Measure::error("gathered_light", "rms_rel"),
-            Format::Percent,
-            true,
-        ),
+        Column::error("mean abs error", "matrix", "mean", Format::Sci, false),
+        Column::error("max abs error", "matrix", "max", Format::Sci, false),
+        Column::error("summed abs error", "matrix", "sum", Format::Sci, true),
+        Column::gathered_light(&format!("gather rms rel ({primary})")),
         Column::new("reorder time", Measure::Seconds, Format::Time, false),
     ];
     reorder_sweep.notes.push(
@@ -414,30 +394,15 @@ pub fn run(
     }
     progress.finish();
     enc_sweep.columns = vec![
-        Column::new(
-            &format!("gather rms rel ({primary})"),
-            Measure::error("gathered_light", "rms_rel"),
-            Format::Percent,
-            true,
-        ),
+        Column::gathered_light(&format!("gather rms rel ({primary})")),
         Column::new(
             "worst standard light",
             Measure::extra("gather_rms_rel_worst_standard"),
             Format::Percent,
             false,
         ),
-        Column::new(
-            "summed abs error",
-            Measure::error("matrix", "sum"),
-            Format::Sci,
-            true,
-        ),
-        Column::new(
-            "max abs error",
-            Measure::error("matrix", "max"),
-            Format::Sci,
-            false,
-        ),
+        Column::error("summed abs error", "matrix", "sum", Format::Sci, true),
+        Column::error("max abs error", "matrix", "max", Format::Sci, false),
         Column::new("bytes", Measure::Bytes, Format::Bytes, true),
         Column::new(
             "encode time",

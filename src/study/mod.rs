@@ -216,6 +216,17 @@ pub struct Column {
 }
 
 impl Column {
+    /// A column of an error metric (`quantity.metric`).
+    pub fn error(header: &str, quantity: &str, metric: &str, format: Format, ratio: bool) -> Self {
+        Column::new(header, Measure::error(quantity, metric), format, ratio)
+    }
+
+    /// The RMS relative error of the gathered light, with a ratio column: every scene sweep's
+    /// headline number.
+    pub fn gathered_light(header: &str) -> Self {
+        Column::error(header, "gathered_light", "rms_rel", Format::Percent, true)
+    }
+
     pub fn new(header: &str, measure: Measure, format: Format, ratio: bool) -> Self {
         Column {
             header: header.into(),

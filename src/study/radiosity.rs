@@ -288,34 +288,16 @@ pub fn patch_sweep(scene: &Scene, cfg: &RadiosityConfig, progress: &dyn Progress
     sweep.baseline = sweep.settings[(sweep.settings.len() - 1) / 2].label.clone();
     sweep.columns = vec![
         Column::new("patches", Measure::extra("patches"), Format::Count, false),
-        Column::new(
-            "B rms rel",
-            Measure::error("gathered_light", "rms_rel"),
-            Format::Percent,
-            true,
-        ),
-        Column::new(
-            "B mean abs",
-            Measure::error("gathered_light", "mean"),
-            Format::Sci,
-            false,
-        ),
-        Column::new(
-            "B max abs",
-            Measure::error("gathered_light", "max"),
-            Format::Sci,
-            false,
-        ),
+        Column::gathered_light("B rms rel"),
+        Column::error("B mean abs", "gathered_light", "mean", Format::Sci, false),
+        Column::error("B max abs", "gathered_light", "max", Format::Sci, false),
         Column::new("time", Measure::Seconds, Format::Time, true),
         Column::new("bytes", Measure::Bytes, Format::Bytes, true),
     ];
     sweep.notes.push(
         "The error mixes discretisation (patches are flat-shaded) with the Monte Carlo noise of the form factors.".into(),
     );
-    sweep.error_plots(
-        Measure::error("gathered_light", "rms_rel"),
-        "B = S.E RMS relative error",
-    );
+    gathered_light_plots(&mut sweep);
     Ok(sweep)
 }
 
@@ -413,39 +395,16 @@ pub fn estimator_sweep(
         .unwrap();
     sweep.columns = vec![
         Column::new("rays", Measure::extra("rays"), Format::Count, false),
-        Column::new(
-            "B rms rel",
-            Measure::error("gathered_light", "rms_rel"),
-            Format::Percent,
-            true,
-        ),
-        Column::new(
-            "F mean abs",
-            Measure::error("form_factors", "mean"),
-            Format::Sci,
-            false,
-        ),
-        Column::new(
-            "F max abs",
-            Measure::error("form_factors", "max"),
-            Format::Sci,
-            false,
-        ),
-        Column::new(
-            "F summed abs",
-            Measure::error("form_factors", "sum"),
-            Format::Sci,
-            true,
-        ),
+        Column::gathered_light("B rms rel"),
+        Column::error("F mean abs", "form_factors", "mean", Format::Sci, false),
+        Column::error("F max abs", "form_factors", "max", Format::Sci, false),
+        Column::error("F summed abs", "form_factors", "sum", Format::Sci, true),
         Column::new("time", Measure::Seconds, Format::Time, true),
     ];
     sweep.notes.push(
         "The reference is itself a Monte Carlo estimate: errors far below its own noise (about 1/sqrt(rays per patch)) are not resolved.".into(),
     );
-    sweep.error_plots(
-        Measure::error("gathered_light", "rms_rel"),
-        "B = S.E RMS relative error",
-    );
+    gathered_light_plots(&mut sweep);
     Ok((sweep, set, baseline_f))
 }
 
@@ -527,27 +486,22 @@ pub fn bounce_sweep(
     }
     progress.finish();
     sweep.columns = vec![
-        Column::new(
-            "B rms rel",
-            Measure::error("gathered_light", "rms_rel"),
-            Format::Sci,
-            true,
-        ),
-        Column::new(
-            "B max abs",
-            Measure::error("gathered_light", "max"),
-            Format::Sci,
-            false,
-        ),
+        Column::error("B rms rel", "gathered_light", "rms_rel", Format::Sci, true),
+        Column::error("B max abs", "gathered_light", "max", Format::Sci, false),
         Column::new("GEMMs", Measure::extra("products"), Format::Count, false),
         Column::new("time", Measure::Seconds, Format::Time, true),
     ];
     sweep.notes.push(
         "k = inf is exact up to f32 rounding of S; finite k misses the light of the bounces it leaves out (bounces_accumulated is 0 for k = inf).".into(),
     );
+    gathered_light_plots(&mut sweep);
+    Ok(sweep)
+}
+
+/// Error of the gathered light against time (and bytes, where they differ).
+fn gathered_light_plots(sweep: &mut Sweep) {
     sweep.error_plots(
         Measure::error("gathered_light", "rms_rel"),
         "B = S.E RMS relative error",
     );
-    Ok(sweep)
 }

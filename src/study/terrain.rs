@@ -184,9 +184,10 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
     progress.finish();
     // Every row names its own baseline (the exact traversal of its size and elevation).
     hard.columns = vec![
-        Column::new(
+        Column::error(
             "differing pixels",
-            Measure::error("shadow_mask", "sum"),
+            "shadow_mask",
+            "sum",
             Format::Count,
             false,
         ),
