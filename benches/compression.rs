@@ -15,6 +15,7 @@ use relume::compress::{
     compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric,
     ReorderOptions, TransportMatrix,
 };
+use relume::study::timing::median_secs;
 use std::time::Instant;
 
 struct Ctx {
@@ -29,18 +30,6 @@ fn gather_errors(ctx: &Ctx, enc: &EncodedTransport) -> Vec<f64> {
         .zip(&ctx.exact)
         .map(|((_, e), x)| rms_relative(&gather(enc, e), x))
         .collect()
-}
-
-fn median_secs(mut f: impl FnMut()) -> f64 {
-    let mut t: Vec<f64> = (0..5)
-        .map(|_| {
-            let t0 = Instant::now();
-            f();
-            t0.elapsed().as_secs_f64()
-        })
-        .collect();
-    t.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    t[2]
 }
 
 fn pct(x: f64) -> String {
@@ -175,7 +164,7 @@ fn main() {
     let seed = compress(&sp_lin, perm_lin.clone(), 4.0, &EncodeOptions::default()).unwrap();
     let seed_bytes = seed.bytes() as f64;
     let e_dense = &ctx.lights[0].1;
-    let dense_secs = median_secs(|| {
+    let dense_secs = median_secs(5, || {
         std::hint::black_box(ctx.s.mat_vec(e_dense));
     });
     println!("\n## Encodings (2 passes Log metric, unless noted)\n");
@@ -223,7 +212,7 @@ fn main() {
         let e = report::entry_errors(sps, &enc);
         let g = gather_errors(&ctx, &enc);
         let worst = g.iter().take(3).cloned().fold(0.0, f64::max);
-        let secs = median_secs(|| {
+        let secs = median_secs(5, || {
             std::hint::black_box(gather(&enc, e_dense));
         });
         println!(

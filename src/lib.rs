@@ -19,6 +19,7 @@ pub mod progress;
 pub mod radiosity;
 pub mod render;
 pub mod scene;
+pub mod study;
 pub mod terrain;
 pub mod workspace;
 

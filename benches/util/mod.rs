@@ -3,23 +3,7 @@
 
 use relume::heightmap::HeightMap;
 
-/// CPU seconds (user + system) of this process so far, from /proc/self/stat (Linux; 0
-/// elsewhere). On a shared machine CPU time is a steadier measure than wall time.
-pub fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit_once(')').map(|(_, a)| a).unwrap_or("");
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    // After the command name the fields start at field 3 (state, a letter, is dropped by the
-    // parse): utime and stime are fields 14 and 15, in clock ticks of 1/100 s.
-    if f.len() > 12 {
-        (f[10] + f[11]) / 100.0
-    } else {
-        0.0
-    }
-}
+pub use relume::study::timing::cpu_seconds;
 
 /// The height map of a bundled pipeline (with its input knobs).
 pub fn load(pipeline: &str) -> HeightMap {

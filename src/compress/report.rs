@@ -18,6 +18,8 @@ pub struct EntryErrors {
     pub mean: f64,
     pub max: f64,
     pub sum: f64,
+    /// Root mean square error over all entries (used by the study; not in the manifest).
+    pub rms: f64,
 }
 
 /// The full report of one encoding.
@@ -53,7 +55,7 @@ impl CompressionReport {
     }
 }
 
-/// Mean, max and summed absolute error of `enc` decoded (in permuted order) against `s_perm`
+/// Mean, max, summed and RMS absolute error of `enc` decoded (in permuted order) against `s_perm`
 /// (= P S Pᵀ). Block by block; never forms the decoded matrix.
 pub fn entry_errors(s_perm: &TransportMatrix, enc: &EncodedTransport) -> EntryErrors {
     let tex = &enc.dense;
@@ -61,7 +63,7 @@ pub fn entry_errors(s_perm: &TransportMatrix, enc: &EncodedTransport) -> EntryEr
     let bw = padded / 4;
     let dec = tex.decoder();
     let side = &enc.sidecar;
-    let per_row: Vec<(f64, f64)> = (0..bw)
+    let per_row: Vec<(f64, f64, f64)> = (0..bw)
         .into_par_iter()
         .map(|by| {
             // The sidecar's share of these four rows.
@@ -79,7 +81,7 @@ pub fn entry_errors(s_perm: &TransportMatrix, enc: &EncodedTransport) -> EntryEr
                 }
             }
             let mut vals: BlockValues = [[0.0; 16]; 3];
-            let (mut sum, mut max) = (0.0f64, 0.0f64);
+            let (mut sum, mut max, mut sq) = (0.0f64, 0.0f64, 0.0f64);
             for bx in 0..bw {
                 dec.block(by, bx, &mut vals);
                 for c in 0..ch {
@@ -89,23 +91,25 @@ pub fn entry_errors(s_perm: &TransportMatrix, enc: &EncodedTransport) -> EntryEr
                             let d = vals[c][t] + extra[(c * 4 + t / 4) * padded + j];
                             let err = (d as f64 - s_perm.get(c, i, j) as f64).abs();
                             sum += err;
+                            sq += err * err;
                             max = max.max(err);
                         }
                     }
                 }
             }
-            (sum, max)
+            (sum, max, sq)
         })
         .collect();
     // Summed in block-row order: the same bits for any thread count.
-    let (sum, max) = per_row
-        .iter()
-        .fold((0.0f64, 0.0f64), |a, b| (a.0 + b.0, a.1.max(b.1)));
+    let (sum, max, sq) = per_row.iter().fold((0.0f64, 0.0f64, 0.0f64), |a, b| {
+        (a.0 + b.0, a.1.max(b.1), a.2 + b.2)
+    });
     let count = (ch * n * n).max(1) as f64;
     EntryErrors {
         mean: sum / count,
         max,
         sum,
+        rms: (sq / count).sqrt(),
     }
 }
 

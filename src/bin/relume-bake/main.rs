@@ -3,6 +3,7 @@
 
 mod compress;
 mod radiosity;
+mod study;
 mod terrain;
 mod ui;
 
@@ -103,6 +104,9 @@ enum Command {
     },
     #[command(flatten)]
     Compress(compress::CompressCommand),
+    /// Speed/accuracy sweeps: error vs time vs bytes for every knob (JSON, Markdown, PNG plots)
+    #[command(after_help = EXIT_CODES)]
+    Study(study::StudyArgs),
 }
 
 #[derive(Args, Clone)]
@@ -262,6 +266,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         Command::Inspect { baked_dir } => inspect(baked_dir, json),
         Command::Radiosity(c) => radiosity::run(c, json, cli.global.quiet, ui),
         Command::Compress(c) => compress::run(c, ui, json, cli.global.quiet),
+        Command::Study(a) => study::run(a, ui, json, cli.global.quiet),
         Command::Shadow(a) => terrain::shadow(a, ui, cli.global.quiet, json),
         Command::Softshadow(a) => terrain::softshadow(a, ui, cli.global.quiet, json),
         Command::Generate(a) => terrain::generate_cmd(a, cli.global.quiet, json),

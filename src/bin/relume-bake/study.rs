@@ -1,0 +1,317 @@
+//! `relume-bake study radiosity|compression|terrain`: the speed/accuracy sweeps of DESIGN.md §7.
+//! Thin: resolve the input (defaults: the bundled Cornell box and Puget Sound), pick the full or
+//! quick configuration with the command line's overrides, run `relume::study`, write the report.
+
+use crate::ui::Ui;
+use clap::{Args, Subcommand};
+use relume::error::exit;
+use relume::heightmap::{load_heightmap, HeightMap};
+use relume::pipeline::{Input, Pipeline, Stage};
+use relume::radiosity::formfactor::{Estimator, FormFactorParams};
+use relume::radiosity::patches::Resolution;
+use relume::radiosity::transport::Bounces;
+use relume::scene::{load_scene, Scene, SceneOptions};
+use relume::study::{self, compression, radiosity, report, terrain, Study};
+use relume::{Error, Result};
+use std::path::{Path, PathBuf};
+
+const STUDY_HELP: &str = "\
+Writes DIR/study.json (every setting: knobs, errors, seconds, bytes), DIR/study.md (a table per
+sweep with ratios against its baseline) and PNG plots (log axes). --quick uses small sizes (well
+under a minute on 2 cores); the full study takes minutes. See docs/study.md.";
+
+#[derive(Args)]
+pub struct StudyArgs {
+    #[command(subcommand)]
+    pub which: Which,
+}
+
+#[derive(Subcommand)]
+pub enum Which {
+    /// Patch count, form-factor estimator × samples, bounces (error of B = S·E)
+    #[command(after_help = STUDY_HELP)]
+    Radiosity(RadiosityArgs),
+    /// Reorder passes, split percentage × dense encoding (error of the decoded S and of S·E)
+    #[command(after_help = STUDY_HELP)]
+    Compression(CompressionArgs),
+    /// Exact vs accelerated hard shadows and the min/max mipmap at several sizes and suns
+    #[command(after_help = STUDY_HELP)]
+    Terrain(TerrainArgs),
+}
+
+#[derive(Args)]
+pub struct Common {
+    /// Output directory (created if missing)
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Small sizes: well under a minute on 2 cores
+    #[arg(long)]
+    pub quick: bool,
+}
+
+#[derive(Args)]
+pub struct SceneSource {
+    /// Scene file (.obj .gltf .glb); default: the bundled Cornell box (scale 0.001)
+    #[arg(long, value_name = "FILE", conflicts_with = "pipeline")]
+    pub scene: Option<PathBuf>,
+    /// Multiply the scene's positions by this (with --scene; default 1)
+    #[arg(long, value_name = "S", requires = "scene")]
+    pub scale: Option<f32>,
+    /// Take the scene (and, for compression, the voxelize/form-factor/transport knobs) from a pipeline
+    #[arg(long, value_name = "FILE")]
+    pub pipeline: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct RadiosityArgs {
+    #[command(flatten)]
+    pub common: Common,
+    #[command(flatten)]
+    pub source: SceneSource,
+    /// Target patch counts of the patch sweep, e.g. 150,600,2400 (the largest is the reference)
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub patches: Option<Vec<u32>>,
+}
+
+#[derive(Args)]
+pub struct CompressionArgs {
+    #[command(flatten)]
+    pub common: Common,
+    #[command(flatten)]
+    pub source: SceneSource,
+    /// Study the transport of an existing bake (transport.npy) instead of baking one
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "pipeline", "patches"])]
+    pub baked: Option<PathBuf>,
+    /// Target patch count of the matrix baked for the study (default 1000, quick 300)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub patches: Option<u32>,
+}
+
+#[derive(Args)]
+pub struct TerrainArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Height map (.png .jpg .exr .tif .raw); default: Puget Sound (pipelines/puget-sound.ron)
+    #[arg(long, value_name = "FILE", conflicts_with = "pipeline")]
+    pub heightmap: Option<PathBuf>,
+    /// Take the height map and its knobs from a pipeline
+    #[arg(long, value_name = "FILE")]
+    pub pipeline: Option<PathBuf>,
+    /// Metres per texel (overrides the file / pipeline)
+    #[arg(long, value_name = "M", value_parser = positive)]
+    pub cell_size: Option<f64>,
+    /// Metres per file unit (overrides the pipeline)
+    #[arg(long, value_name = "S", value_parser = positive)]
+    pub height_scale: Option<f64>,
+    /// Map sizes (longer side, texels), e.g. 1024,2048,4096
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub sizes: Option<Vec<u32>>,
+    /// Sun elevations in degrees, e.g. 5,15,30,60
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = elevation, allow_hyphen_values = true)]
+    pub elevations: Option<Vec<f64>>,
+    /// Sun azimuth, degrees clockwise from north
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true, value_parser = finite)]
+    pub azimuth: Option<f64>,
+}
+
+fn finite(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("`{s}` is not a finite number")),
+    }
+}
+
+fn positive(s: &str) -> std::result::Result<f64, String> {
+    match finite(s)? {
+        v if v > 0.0 => Ok(v),
+        _ => Err(format!("`{s}` must be greater than 0")),
+    }
+}
+
+fn elevation(s: &str) -> std::result::Result<f64, String> {
+    match finite(s)? {
+        v if (-90.0..=90.0).contains(&v) => Ok(v),
+        _ => Err(format!("sun elevation `{s}` is not in [-90, 90] degrees")),
+    }
+}
+
+/// A bundled file: relative to the current directory, else to the source tree relume was built
+/// from.
+fn bundled(rel: &str) -> Result<PathBuf> {
+    let here = PathBuf::from(rel);
+    if here.exists() {
+        return Ok(here);
+    }
+    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    if built.exists() {
+        return Ok(built);
+    }
+    Err(Error::input(
+        rel,
+        "the bundled default input is not here nor in the source tree relume was built from; name an input explicitly",
+    ))
+}
+
+/// The scene to study and a description of it; the pipeline when one was given.
+fn scene_of(src: &SceneSource) -> Result<(Scene, String, Option<Pipeline>)> {
+    if let Some(p) = &src.pipeline {
+        let pipeline = relume::pipeline::parse_pipeline(p)?;
+        let Input::Scene(s) = &pipeline.input else {
+            return Err(Error::input(
+                p,
+                "this pipeline's input is a height map; the radiosity and compression studies need a scene",
+            ));
+        };
+        let (scene, _) = load_scene(&s.path, s.options())?;
+        return Ok((
+            scene,
+            format!("the scene of {}", p.display()),
+            Some(pipeline),
+        ));
+    }
+    let (path, scale) = match &src.scene {
+        Some(s) => (s.clone(), src.scale.unwrap_or(1.0)),
+        None => (bundled("scenes/cornell-box/cornell_box.obj")?, 0.001),
+    };
+    let (scene, _) = load_scene(&path, SceneOptions { scale })?;
+    Ok((scene, format!("{} (scale {scale})", path.display()), None))
+}
+
+fn map_of(args: &TerrainArgs) -> Result<(HeightMap, String)> {
+    let (path, mut opts, name) = match (&args.heightmap, &args.pipeline) {
+        (Some(h), _) => (h.clone(), Default::default(), h.display().to_string()),
+        (None, p) => {
+            let p = match p {
+                Some(p) => p.clone(),
+                None => bundled("pipelines/puget-sound.ron")?,
+            };
+            let pipeline = relume::pipeline::parse_pipeline(&p)?;
+            let Input::HeightMap(h) = &pipeline.input else {
+                return Err(Error::input(
+                    &p,
+                    "this pipeline's input is a scene; the terrain study needs a height map",
+                ));
+            };
+            (
+                h.path.clone(),
+                h.options(),
+                format!("the height map of {}", p.display()),
+            )
+        }
+    };
+    if let Some(c) = args.cell_size {
+        opts.cell_size = Some([c, c]);
+    }
+    if let Some(s) = args.height_scale {
+        opts.height_scale = Some(s);
+    }
+    let (map, _) = load_heightmap(&path, &opts)?;
+    let name = format!(
+        "{name}: {}x{}, cell {} x {} m",
+        map.width, map.height, map.cell_size[0], map.cell_size[1]
+    );
+    Ok((map, name))
+}
+
+/// The compression study's matrix: a bake's, or one baked from the scene with the pipeline's
+/// (else default) knobs.
+fn compression_input(args: &CompressionArgs, quick: bool) -> Result<compression::CompressionInput> {
+    if let Some(dir) = &args.baked {
+        return compression::input_from_bake(dir);
+    }
+    let (scene, name, pipeline) = scene_of(&args.source)?;
+    let mut resolution = Resolution::TargetPatches(if quick { 300 } else { 1000 });
+    let mut ff = FormFactorParams {
+        estimator: Estimator::Hemisphere,
+        samples: if quick { 512 } else { 4096 },
+        seed: 0,
+    };
+    let mut bounces = Bounces::Infinite;
+    for stage in pipeline.iter().flat_map(|p| &p.stages) {
+        match stage {
+            Stage::Voxelize(k) => resolution = k.resolution,
+            Stage::FormFactors(k) => {
+                ff = FormFactorParams {
+                    estimator: k.estimator,
+                    samples: k.samples.unwrap_or_else(|| k.estimator.default_samples()),
+                    seed: k.seed,
+                }
+            }
+            Stage::Transport(k) => bounces = k.bounces,
+            _ => {}
+        }
+    }
+    if let Some(n) = args.patches {
+        resolution = Resolution::TargetPatches(n);
+    }
+    compression::input_from_scene(&scene, resolution, &ff, bounces, &name)
+}
+
+/// `relume-bake study ...`.
+pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
+    let (out, quick) = match &args.which {
+        Which::Radiosity(a) => (&a.common.out, a.common.quick),
+        Which::Compression(a) => (&a.common.out, a.common.quick),
+        Which::Terrain(a) => (&a.common.out, a.common.quick),
+    };
+    // Refuse an unusable output path before minutes of work.
+    report::prepare_dir(out)?;
+    let mut study = match &args.which {
+        Which::Radiosity(a) => {
+            let (scene, name, _) = scene_of(&a.source)?;
+            let mut cfg = if quick {
+                radiosity::RadiosityConfig::quick()
+            } else {
+                radiosity::RadiosityConfig::full()
+            };
+            if let Some(p) = &a.patches {
+                cfg.patch_targets = p.clone();
+            }
+            Study::new("radiosity", name, quick, radiosity::run(&scene, &cfg, ui)?)
+        }
+        Which::Compression(a) => {
+            let input = compression_input(a, quick)?;
+            let cfg = if quick {
+                compression::CompressionConfig::quick()
+            } else {
+                compression::CompressionConfig::full()
+            };
+            let sweeps = compression::run(&input, &cfg, ui)?;
+            Study::new("compression", input.description.clone(), quick, sweeps)
+        }
+        Which::Terrain(a) => {
+            let (map, name) = map_of(a)?;
+            let mut cfg = if quick {
+                terrain::TerrainConfig::quick()
+            } else {
+                terrain::TerrainConfig::full()
+            };
+            if let Some(s) = &a.sizes {
+                cfg.sizes = s.iter().map(|&v| v as usize).collect();
+            }
+            if let Some(e) = &a.elevations {
+                cfg.elevations = e.clone();
+            }
+            if let Some(az) = a.azimuth {
+                cfg.azimuth = az;
+            }
+            Study::new("terrain", name, quick, terrain::run(&map, &cfg, ui)?)
+        }
+    };
+    study::report::write(&mut study, out)?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&study).expect("study serialises")
+        );
+    } else if !quiet {
+        println!("{}", report::markdown(&study));
+        eprintln!(
+            "wrote {} ({} files: {})",
+            out.display(),
+            study.files.len(),
+            study.files.join(", ")
+        );
+    }
+    Ok(exit::OK)
+}

@@ -1,0 +1,373 @@
+//! `relume-bake study` end to end with the real binary, in `--quick` mode: the JSON has the
+//! expected settings with finite errors and zero error for the settings that are their own
+//! reference, the Markdown has a table per sweep, the PNG plots decode and are not blank, the
+//! terrain sweep finds 0 differing pixels, the report does not depend on the thread count, and
+//! bad arguments are refused with clear messages.
+
+mod common;
+
+use common::{bake, data, expect_code};
+use serde_json::Value;
+use std::path::Path;
+
+/// Run a quick study into `dir/out` with `--json`; returns the parsed stdout, after checking
+/// that it equals `study.json`.
+fn study(dir: &Path, args: &[&str]) -> Value {
+    let out = dir.join("out");
+    let mut all = vec!["study"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--quick", "--json", "--out", out.to_str().unwrap()]);
+    let o = bake(dir, &all);
+    expect_code(&o, 0);
+    let printed: Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON");
+    let file: Value =
+        serde_json::from_slice(&std::fs::read(out.join("study.json")).unwrap()).unwrap();
+    assert_eq!(printed, file);
+    check_files(&out, &file);
+    file
+}
+
+fn sweep<'a>(j: &'a Value, name: &str) -> &'a Value {
+    j["sweeps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("no sweep {name}"))
+}
+
+fn settings(s: &Value) -> &Vec<Value> {
+    s["settings"].as_array().unwrap()
+}
+
+fn labels(s: &Value) -> Vec<&str> {
+    settings(s)
+        .iter()
+        .map(|x| x["label"].as_str().unwrap())
+        .collect()
+}
+
+fn setting<'a>(s: &'a Value, label: &str) -> &'a Value {
+    settings(s)
+        .iter()
+        .find(|x| x["label"] == label)
+        .unwrap_or_else(|| panic!("no setting {label} in {}", s["name"]))
+}
+
+fn err(s: &Value, quantity: &str, metric: &str) -> f64 {
+    s["errors"][quantity][metric]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{quantity}.{metric} of {}", s["label"]))
+}
+
+/// Every error number, time and byte count is finite and non-negative; a reference setting
+/// has error exactly 0 in every quantity and metric.
+fn check_numbers(j: &Value) {
+    for sw in j["sweeps"].as_array().unwrap() {
+        for s in settings(sw) {
+            assert!(s["seconds"].as_f64().unwrap() >= 0.0);
+            assert!(s["bytes"].as_u64().is_some());
+            for (q, e) in s["errors"].as_object().unwrap() {
+                for (m, v) in e.as_object().unwrap() {
+                    let v = v
+                        .as_f64()
+                        .unwrap_or_else(|| panic!("{q}.{m} of {} is not a number", s["label"]));
+                    assert!(v.is_finite() && v >= 0.0, "{q}.{m} of {} = {v}", s["label"]);
+                    if s["reference"] == true {
+                        assert_eq!(v, 0.0, "reference {} has {q}.{m} = {v}", s["label"]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// study.md has a table per sweep with one row per setting; every listed plot decodes to a
+/// 960x600 image that is not blank.
+fn check_files(out: &Path, j: &Value) {
+    let md = std::fs::read_to_string(out.join("study.md")).unwrap();
+    for sw in j["sweeps"].as_array().unwrap() {
+        let title = format!("## {}", sw["title"].as_str().unwrap());
+        let at = md
+            .find(&title)
+            .unwrap_or_else(|| panic!("no {title} in study.md"));
+        let rows = md[at..]
+            .lines()
+            .skip_while(|l| !l.starts_with("| setting |"))
+            .skip(2)
+            .take_while(|l| l.starts_with('|'))
+            .count();
+        assert_eq!(rows, settings(sw).len(), "table rows of {title}");
+        for p in sw["plots"].as_array().unwrap() {
+            let file = p["file"].as_str().unwrap();
+            assert!(md.contains(&format!("]({file})")), "study.md links {file}");
+            let img = image::open(out.join(file)).unwrap().to_rgb8();
+            assert_eq!(img.dimensions(), (960, 600), "{file}");
+            let colours: std::collections::HashSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+            let ink = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+            assert!(colours.len() >= 4 && ink > 5_000, "{file} looks blank");
+        }
+    }
+    let listed: Vec<&str> = j["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    for f in &listed {
+        assert!(out.join(f).is_file(), "{f} listed but missing");
+    }
+    assert!(listed.contains(&"study.md") && listed.contains(&"study.json"));
+}
+
+#[test]
+fn radiosity_quick_sweeps_patches_estimators_and_bounces() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = study(dir.path(), &["radiosity"]);
+    assert_eq!(j["study"], "radiosity");
+    assert_eq!(j["quick"], true);
+    check_numbers(&j);
+
+    let p = sweep(&j, "radiosity_patches");
+    assert_eq!(labels(p), ["target 50", "target 150", "target 400"]);
+    assert_eq!(setting(p, "target 400")["reference"], true);
+    let e50 = err(setting(p, "target 50"), "gathered_light", "rms_rel");
+    assert!(e50 > 0.0 && e50 < 1.0, "coarse patches: {e50}");
+    assert_eq!(
+        p["plots"].as_array().unwrap().len(),
+        2,
+        "error vs time and vs bytes"
+    );
+
+    let e = sweep(&j, "radiosity_estimator");
+    assert_eq!(
+        labels(e),
+        [
+            "hemisphere 64",
+            "hemisphere 256",
+            "hemisphere 1024",
+            "pairwise 4",
+            "pairwise 16",
+            "hemisphere 4096"
+        ]
+    );
+    let r = setting(e, "hemisphere 4096");
+    assert_eq!(r["reference"], true);
+    assert_eq!(err(r, "form_factors", "sum"), 0.0);
+    // More rays, less error (against a reference 4x denser than the densest swept).
+    let f = |l| err(setting(e, l), "form_factors", "sum");
+    assert!(f("hemisphere 64") > f("hemisphere 256") && f("hemisphere 256") > f("hemisphere 1024"));
+
+    let b = sweep(&j, "radiosity_bounces");
+    assert_eq!(
+        labels(b),
+        [
+            "gauss-seidel f64",
+            "k = 1",
+            "k = 2",
+            "k = 3",
+            "k = 8",
+            "k = inf",
+            "auto 1e-3"
+        ]
+    );
+    let g = |l| err(setting(b, l), "gathered_light", "rms_rel");
+    // Every bounce adds light the reference has: the error falls monotonically with k, and
+    // k = ∞ matches the f64 Gauss–Seidel solution to f32 rounding.
+    assert!(g("k = 1") > g("k = 2") && g("k = 2") > g("k = 3") && g("k = 3") > g("k = 8"));
+    assert!(
+        g("k = inf") < 1e-5,
+        "k = inf vs Gauss–Seidel: {}",
+        g("k = inf")
+    );
+    assert!(g("auto 1e-3") < g("k = 8"));
+}
+
+#[test]
+fn compression_quick_sweeps_reorder_split_and_encodings() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = study(dir.path(), &["compression"]);
+    check_numbers(&j);
+    let r = sweep(&j, "compression_reorder");
+    assert_eq!(
+        labels(r),
+        [
+            "0 passes",
+            "1 passes Linear",
+            "1 passes Log",
+            "2 passes Linear",
+            "2 passes Log"
+        ]
+    );
+    for s in settings(r) {
+        // The seed's three numbers are all there.
+        for m in ["mean", "max", "sum"] {
+            assert!(err(s, "matrix", m) > 0.0);
+        }
+    }
+    let e = sweep(&j, "compression_encoding");
+    assert_eq!(settings(e).len(), 1 + 5 * 5 + 1);
+    assert_eq!(setting(e, "uncompressed f32")["reference"], true);
+    // F32 without a sidecar stores S exactly: the decoded matrix has no error at all.
+    assert_eq!(err(setting(e, "f32 p=0"), "matrix", "sum"), 0.0);
+    assert!(err(setting(e, "f32 p=0"), "gathered_light", "rms_rel") < 1e-5);
+    let bytes = |l| setting(e, l)["bytes"].as_u64().unwrap();
+    assert!(bytes("f32 p=0") > bytes("f16 p=0") && bytes("f16 p=0") > bytes("bc6h p=0"));
+    assert!(bytes("bc6h p=0") > bytes("bc1_log p=0"));
+    // A bigger sidecar costs bytes.
+    assert!(bytes("bc6h p=8") > bytes("bc6h p=1"));
+    assert_eq!(e["baseline"], "seed: bc1_log p=4 zeroed holes");
+}
+
+#[test]
+fn terrain_quick_accelerated_equals_exact_and_report_is_thread_independent() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = study(dir.path(), &["terrain", "-j", "1"]);
+    check_numbers(&j);
+    let h = sweep(&j, "terrain_hard_shadows");
+    assert_eq!(
+        settings(h).len(),
+        2 * 2 * 2,
+        "2 sizes x 2 elevations x 2 methods"
+    );
+    for s in settings(h) {
+        assert_eq!(
+            err(s, "shadow_mask", "sum"),
+            0.0,
+            "differing pixels in {}",
+            s["label"]
+        );
+        assert_eq!(s["reference"], s["knobs"]["method"] == "exact");
+    }
+    assert!(
+        setting(h, "512 5° exact")["extra"]["shadowed_fraction"]
+            .as_f64()
+            .unwrap()
+            > 0.01
+    );
+    let m = sweep(&j, "terrain_mipmap");
+    assert_eq!(labels(m), ["256x256", "512x512"]);
+    assert!(settings(m)[1]["bytes"].as_u64() > settings(m)[0]["bytes"].as_u64());
+
+    // Everything but the times is the same with two threads.
+    let dir2 = tempfile::tempdir().unwrap();
+    let j2 = study(dir2.path(), &["terrain", "-j", "2"]);
+    assert_eq!(strip_times(j), strip_times(j2));
+}
+
+/// The report without measured times (and numbers derived from them) and the thread count.
+fn strip_times(mut j: Value) -> Value {
+    j["threads"] = Value::Null;
+    for sw in j["sweeps"].as_array_mut().unwrap() {
+        for s in sw["settings"].as_array_mut().unwrap() {
+            s["seconds"] = Value::Null;
+            let extra = s["extra"].as_object_mut().unwrap();
+            extra.retain(|k, _| !(k.contains("second") || k.contains("speedup")));
+        }
+    }
+    j
+}
+
+#[test]
+fn compression_study_of_an_existing_bake_uses_its_emitters() {
+    let dir = tempfile::tempdir().unwrap();
+    let pipeline = dir.path().join("small.ron");
+    std::fs::write(
+        &pipeline,
+        format!(
+            "Pipeline(input: Scene(path: {:?}, scale: 0.001), stages: [Voxelize(resolution: TargetPatches(60)), FormFactors(samples: 256), Transport()])",
+            data("scenes/cornell-box/cornell_box.obj")
+        ),
+    )
+    .unwrap();
+    expect_code(
+        &bake(dir.path(), &["run", "small.ron", "--out", "baked", "-q"]),
+        0,
+    );
+    let j = study(dir.path(), &["compression", "--baked", "baked"]);
+    check_numbers(&j);
+    let e = sweep(&j, "compression_encoding");
+    assert!(e["reference"].as_str().unwrap().contains("`emitters`"));
+    assert!(setting(e, "bc6h p=1")["extra"]["gather_rms_rel_emitters"]
+        .as_f64()
+        .is_some());
+}
+
+#[test]
+fn bad_arguments_are_refused_clearly_and_leave_no_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let no_json = |o: &std::process::Output| {
+        assert!(
+            !d.join("o/study.json").exists(),
+            "no report after a refusal"
+        );
+        let _ = o;
+    };
+    // Usage errors (clap): exit 2.
+    expect_code(&bake(d, &["study"]), 2);
+    let e = expect_code(&bake(d, &["study", "terrain", "--quick"]), 2);
+    assert!(e.contains("--out"), "{e}");
+    let e = expect_code(
+        &bake(
+            d,
+            &["study", "terrain", "--out", "o", "--elevations", "5,95"],
+        ),
+        2,
+    );
+    assert!(e.contains("not in [-90, 90]"), "{e}");
+    let e = expect_code(
+        &bake(
+            d,
+            &[
+                "study",
+                "compression",
+                "--out",
+                "o",
+                "--baked",
+                "b",
+                "--scene",
+                "s.obj",
+            ],
+        ),
+        2,
+    );
+    assert!(e.contains("cannot be used with"), "{e}");
+    expect_code(
+        &bake(d, &["study", "radiosity", "--out", "o", "--patches", "0"]),
+        2,
+    );
+    // Invalid inputs and knobs: exit 3, naming the problem.
+    let o = bake(
+        d,
+        &[
+            "study", "terrain", "--quick", "--out", "o", "--sizes", "10000",
+        ],
+    );
+    let e = expect_code(&o, 3);
+    assert!(e.contains("study size 10000"), "{e}");
+    no_json(&o);
+    let puget = data("pipelines/puget-sound.ron");
+    let o = bake(
+        d,
+        &[
+            "study",
+            "radiosity",
+            "--quick",
+            "--out",
+            "o",
+            "--pipeline",
+            puget.to_str().unwrap(),
+        ],
+    );
+    let e = expect_code(&o, 3);
+    assert!(e.contains("input is a height map"), "{e}");
+    no_json(&o);
+    // An output path that is a file: exit 4, before any work.
+    std::fs::write(d.join("file"), "x").unwrap();
+    let e = expect_code(
+        &bake(d, &["study", "terrain", "--quick", "--out", "file"]),
+        4,
+    );
+    assert!(e.contains("not a directory"), "{e}");
+}
