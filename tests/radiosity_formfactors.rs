@@ -260,6 +260,28 @@ fn far_translation_and_tiny_scale_give_the_same_form_factors() {
     }
 }
 
+/// A box whose voxel grid leaves a sliver patch along a concave edge: ray origins sampled on
+/// the edge lie (within f32 rounding) in the plane of the adjoining wall, just outside it. A ray
+/// leaving them used to stop on that wall's back face at t ≈ 1e-7 and be absorbed (row sum
+/// 127/128). Found by `hemisphere_rows_of_any_closed_box_sum_to_one`.
+#[test]
+fn hemisphere_rays_from_a_concave_edge_do_not_leak() {
+    let scene = fixtures::closed_box(
+        [0.4826909330491666, 1.373498247580672, 1.832776343537829],
+        0.5,
+        0.0,
+    );
+    let set = patches(&scene, Resolution::TargetPatches(60));
+    let f = ff(&scene, &set, Estimator::Hemisphere, 128, 2);
+    for i in 0..f.n {
+        assert!(
+            (f.row_sum(i) - 1.0).abs() < 1e-5,
+            "row {i} sums to {}",
+            f.row_sum(i)
+        );
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(12))]
 

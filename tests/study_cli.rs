@@ -249,6 +249,33 @@ fn terrain_quick_accelerated_equals_exact_and_report_is_thread_independent() {
     assert_eq!(labels(m), ["256x256", "512x512"]);
     assert!(settings(m)[1]["bytes"].as_u64() > settings(m)[0]["bytes"].as_u64());
 
+    // Soft shadows: branch-and-bound is exact, uniform stepping and coarse dynamic programming
+    // are not, on pixels that are really in penumbra.
+    let soft = sweep(&j, "terrain_soft_shadows");
+    for size in ["256x256", "512x512"] {
+        let s = |m: &str| setting(soft, &format!("{size} 5° {m}"));
+        assert_eq!(s("exhaustive")["reference"], true);
+        assert!(
+            s("exhaustive")["extra"]["penumbra_fraction"]
+                .as_f64()
+                .unwrap()
+                > 0.001
+        );
+        assert!(err(s("branch and bound"), "lit_fraction", "max") < 1e-6);
+        assert!(err(s("uniform 32"), "lit_fraction", "max") > 0.01);
+        assert!(
+            err(
+                s("dynamic programming, start level 4"),
+                "lit_fraction",
+                "mean"
+            ) > 1e-4
+        );
+        assert_eq!(
+            s("uniform 32")["baseline"],
+            format!("{size} 5° uniform 100")
+        );
+    }
+
     // Everything but the times is the same with two threads.
     let dir2 = tempfile::tempdir().unwrap();
     let j2 = study(dir2.path(), &["terrain", "-j", "2"]);
@@ -262,7 +289,9 @@ fn strip_times(mut j: Value) -> Value {
         for s in sw["settings"].as_array_mut().unwrap() {
             s["seconds"] = Value::Null;
             let extra = s["extra"].as_object_mut().unwrap();
-            extra.retain(|k, _| !(k.contains("second") || k.contains("speedup")));
+            extra.retain(|k, _| {
+                !(k.contains("second") || k.contains("speedup") || k.contains("per_pixel"))
+            });
         }
     }
     j

@@ -99,8 +99,10 @@ impl Visibility {
         );
         let mut hit = RayHit::none();
         let found = self.bvh.ray_traverse(ray, &mut hit, |r, id| {
-            wt.intersect(
-                &self.tris[self.bvh.primitive_indices[id] as usize],
+            self.hit_distance(
+                &wt,
+                self.bvh.primitive_indices[id] as usize,
+                dir,
                 BACKOFF,
                 r.tmax,
             )
@@ -121,8 +123,8 @@ impl Visibility {
         let wt = Watertight::new(origin, dir);
         let d = Vec3A::from(dir.as_vec3());
         let mut best: Option<Hit> = None;
-        for (k, tri) in self.tris.iter().enumerate() {
-            let t = wt.intersect(tri, 0.0, best.map_or(f32::INFINITY, |b| b.t));
+        for k in 0..self.tris.len() {
+            let t = self.hit_distance(&wt, k, dir, 0.0, best.map_or(f32::INFINITY, |b| b.t));
             if t.is_finite() && best.is_none_or(|b| t < b.t) {
                 best = Some(Hit {
                     triangle: self.ids[k],
@@ -132,6 +134,24 @@ impl Visibility {
             }
         }
         best
+    }
+
+    /// Distance along the ray of `wt` (which starts `start` before the caller's origin) to BVH
+    /// triangle `k`, or infinity. A back face closer than [`Visibility::epsilon`] to the origin
+    /// is a surface the origin lies on (within rounding: a sample on the edge of a concave
+    /// corner lies in the plane of the adjoining wall) and that the ray leaves through its front
+    /// side, so it does not stop the ray; a front face at any distance does.
+    #[inline]
+    fn hit_distance(&self, wt: &Watertight, k: usize, dir: DVec3, start: f32, tmax: f32) -> f32 {
+        let t = wt.intersect(&self.tris[k], start, tmax);
+        if t.is_finite()
+            && t - start < self.epsilon
+            && self.normals[k].dot(Vec3A::from(dir.as_vec3())) >= 0.0
+        {
+            f32::INFINITY
+        } else {
+            t
+        }
     }
 
     /// True when a surface lies on the segment from `from` to `to` (both lifted off their
@@ -152,8 +172,10 @@ impl Visibility {
             len as f32 + BACKOFF,
         );
         !self.bvh.ray_traverse_miss(ray, |r, id| {
-            wt.intersect(
-                &self.tris[self.bvh.primitive_indices[id] as usize],
+            self.hit_distance(
+                &wt,
+                self.bvh.primitive_indices[id] as usize,
+                dir,
                 BACKOFF,
                 r.tmax,
             )

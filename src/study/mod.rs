@@ -8,8 +8,8 @@
 //! - [`compression`]: reorder passes, split percentage × dense encoding (reference: the
 //!   uncompressed transport and its dense mat-vec);
 //! - [`terrain`]: exact vs accelerated hard shadows at several map sizes and sun elevations,
-//!   min/max mipmap build (reference: the exact traversal). Soft shadows: see the extension
-//!   point documented in [`terrain`].
+//!   min/max mipmap build (reference: the exact traversal); soft shadows ([`soft_shadows`]:
+//!   uniform stepping, dynamic programming, branch-and-bound; reference: the exhaustive walk).
 //!
 //! Each sweep returns a [`Sweep`]: plain data that [`report`] writes as `study.json`, `study.md`
 //! (a table per sweep with ratios against the sweep's baseline setting) and PNG plots
@@ -19,6 +19,7 @@ pub mod compression;
 pub mod plot;
 pub mod radiosity;
 pub mod report;
+pub mod soft_shadows;
 pub mod terrain;
 pub mod timing;
 

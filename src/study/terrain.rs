@@ -5,21 +5,9 @@
 //! fraction (`mean`), and relative to the shadowed pixels (`rms_rel` = sqrt(differing /
 //! shadowed)).
 //!
-//! # Extension point: soft shadows (issue 6)
-//!
-//! When the soft-shadow methods land (`exhaustive`, `uniform { steps }`,
-//! `dynamic_programming { start_level, intervals }`, `branch_and_bound`), add one function here,
-//! `soft_shadow_sweep(maps: &[HeightMap], cfg: &TerrainConfig, progress) -> Result<Sweep>`,
-//! over the downsampled maps [`run`] already builds (`maps`; build each one's `MinMaxMipmap`
-//! once, as the hard-shadow loop does): one [`Setting`] per (size, elevation, method, steps /
-//! start level) with `errors["lit_fraction"]` = `ErrorStats::of(lit, exhaustive_lit, None)`
-//! (mean and max absolute lit fraction against `exhaustive`, which is the reference row, error
-//! exactly 0), `seconds` = the whole-image time, `baseline` = `Some(label of the uniform-100
-//! row of the same size and elevation)` (the issue's ratio), and `sweep.error_plots(...)`.
-//! Give [`TerrainConfig`] the swept steps / levels / elevations (full and quick values) and push
-//! the sweep in [`run`] where the comment marks it. Nothing else (CLI,
-//! report, plots, JSON) needs to change.
+//! The soft-shadow methods are compared in [`super::soft_shadows`] on the same maps.
 
+use super::soft_shadows::{soft_shadow_sweep, SoftConfig};
 use super::timing::{timed, timed_cpu};
 use super::{relative, Column, ErrorStats, Format, Measure, PlotSpec, Setting, Sweep};
 use crate::error::{Error, Result};
@@ -37,6 +25,8 @@ pub struct TerrainConfig {
     pub elevations: Vec<f64>,
     /// Sun azimuth in degrees clockwise from north.
     pub azimuth: f64,
+    /// The soft-shadow sweep (on the same sizes and azimuth).
+    pub soft: SoftConfig,
 }
 
 impl TerrainConfig {
@@ -46,6 +36,7 @@ impl TerrainConfig {
             sizes: vec![1024, 2048, 4096],
             elevations: vec![5.0, 15.0, 30.0, 60.0],
             azimuth: 300.0,
+            soft: SoftConfig::full(),
         }
     }
 
@@ -54,6 +45,7 @@ impl TerrainConfig {
             sizes: vec![256, 512],
             elevations: vec![5.0, 30.0],
             azimuth: 300.0,
+            soft: SoftConfig::quick(),
         }
     }
 }
@@ -128,7 +120,9 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
         ..Default::default()
     };
     progress.begin("study: hard shadows", (maps.len() * suns.len()) as u64);
-    for m in &maps {
+    let mut with_mips = Vec::new();
+    for map in maps {
+        let m = &map;
         let size = m.width.max(m.height);
         let pixels = (m.width * m.height) as f64;
         let (mip, build) = timed(|| MinMaxMipmap::build(m));
@@ -180,6 +174,7 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
             }
             progress.advance(1);
         }
+        with_mips.push((map, mip));
     }
     progress.finish();
     // Every row names its own baseline (the exact traversal of its size and elevation).
@@ -248,6 +243,6 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
         x_label: "pixels".into(),
         y_label: "seconds (build, wall)".into(),
     });
-    // Extension point (issue 6): push `soft_shadow_sweep(...)` here (see the module doc).
-    Ok(vec![hard, mip_sweep])
+    let soft = soft_shadow_sweep(&with_mips, cfg.azimuth, &cfg.soft, progress)?;
+    Ok(vec![hard, mip_sweep, soft])
 }

@@ -112,6 +112,13 @@ pub struct TerrainArgs {
     /// Sun azimuth, degrees clockwise from north
     #[arg(long, value_name = "DEG", allow_hyphen_values = true, value_parser = finite)]
     pub azimuth: Option<f64>,
+    /// Sun elevations of the soft-shadow sweep in degrees, e.g. 2,5,10
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = elevation, allow_hyphen_values = true)]
+    pub soft_elevations: Option<Vec<f64>>,
+    /// Rows of each map the soft-shadow sweep times (evenly spaced; the exhaustive reference
+    /// is slow at low sun)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub soft_rows: Option<u32>,
 }
 
 fn finite(s: &str) -> std::result::Result<f64, String> {
@@ -294,6 +301,12 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
             }
             if let Some(az) = a.azimuth {
                 cfg.azimuth = az;
+            }
+            if let Some(e) = &a.soft_elevations {
+                cfg.soft.elevations = e.clone();
+            }
+            if let Some(r) = a.soft_rows {
+                cfg.soft.rows = r as usize;
             }
             Study::new("terrain", name, quick, terrain::run(&map, &cfg, ui)?)
         }
