@@ -34,7 +34,7 @@ pub enum Which {
     /// Reorder passes, split percentage × dense encoding (error of the decoded S and of S·E)
     #[command(after_help = STUDY_HELP)]
     Compression(CompressionArgs),
-    /// Exact vs accelerated hard shadows and the min/max mipmap at several sizes and suns
+    /// Hard shadows (exact vs accelerated), the min/max mipmap, soft shadows (every method vs exhaustive)
     #[command(after_help = STUDY_HELP)]
     Terrain(TerrainArgs),
 }
