@@ -18,12 +18,14 @@ all: build
 build:
 	$(CARGO) build --release --locked
 
-## The main job on the bundled default: bake the Cornell box (voxelize → form factors → transport)
-## and Puget Sound.
+## The main job on the bundled default: bake the Cornell box (voxelize → form factors → transport
+## → reorder → encode) and Puget Sound (min/max mipmap, at 4K and 2K), compute terrain shadows on
+## the CPU, and render headless frames of both with the player (Mesa lavapipe when no GPU).
 demo: build
 	@mkdir -p out/demo
 	$(BAKE) run pipelines/cornell.ron --out out/demo/cornell
 	$(BAKE) run pipelines/puget-sound.ron --out out/demo/puget-sound
+	$(BAKE) run pipelines/puget-sound-2k.ron --out out/demo/puget-sound-2k
 	$(BAKE) inspect out/demo/cornell
 	$(BAKE) export out/demo/cornell patches --out out/demo/cornell-patches.json
 	$(BAKE) inspect out/demo/puget-sound
@@ -33,12 +35,23 @@ demo: build
 	    --out out/demo/puget-sound-lit.png --shaded out/demo/puget-sound-soft-relief.png
 	@mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
 	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --out out/demo/cornell-frames
-	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --sun 135,25 --frames 4 --out out/demo/cornell-sun-frames
+	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --sun 0,25 --frames 4 \
+	    --out out/demo/cornell-sun-frames
+	$(PLAYER) out/demo/puget-sound-2k --headless --size 640x480 --sun 300,6 --frames 2 \
+	    --out out/demo/puget-sound-frames
+	$(PLAYER) out/demo/puget-sound-2k --headless --size 640x480 --sun 300,6 --soft \
+	    --out out/demo/puget-sound-soft-frames
 	@echo
 	@echo "demo output is in out/demo/:"
-	@echo "  out/demo/cornell/, out/demo/puget-sound/           baked directories (relume-bake inspect DIR)"
-	@echo "  out/demo/cornell-frames/frame_0000.png             the Cornell box lit by its ceiling light"
-	@echo "  out/demo/cornell-sun-frames/frame_000[0-3].png     plus a sun turning around it"
+	@echo "  cornell/, puget-sound/, puget-sound-2k/        baked directories (relume-bake inspect DIR)"
+	@echo "  cornell-patches.json                           the Cornell box's patches"
+	@echo "  puget-sound-shadow.png, puget-sound-relief.png hard shadows (CPU, 4K, sun 300°/10°)"
+	@echo "  puget-sound-lit.png, puget-sound-soft-relief.png  soft shadows (CPU, 4K, sun 300°/3°)"
+	@echo "  cornell-frames/frame_0000.png                  player: the Cornell box lit by its ceiling light"
+	@echo "  cornell-sun-frames/frame_000[0-3].png          player: plus a sun turning around it (0°, 90°, 180°, 270°)"
+	@echo "  puget-sound-frames/frame_000[0-1].png          player: Puget Sound 2K, hard relief shadows"
+	@echo "  puget-sound-soft-frames/frame_0000.png         player: Puget Sound 2K, soft shadows"
+	@echo "  */frames.json                                  adapter and per-pass frame times"
 
 ## Install what the tests need (software Vulkan, Python cross-check readers), then run them all.
 test: deps
