@@ -395,25 +395,20 @@ pub fn run(
     progress.finish();
     enc_sweep.columns = vec![
         Column::gathered_light(&format!("gather rms rel ({primary})")),
-        Column::new(
+        Column::extra(
             "worst standard light",
-            Measure::extra("gather_rms_rel_worst_standard"),
+            "gather_rms_rel_worst_standard",
             Format::Percent,
             false,
         ),
         Column::error("summed abs error", "matrix", "sum", Format::Sci, true),
         Column::error("max abs error", "matrix", "max", Format::Sci, false),
         Column::new("bytes", Measure::Bytes, Format::Bytes, true),
-        Column::new(
-            "encode time",
-            Measure::extra("encode_seconds"),
-            Format::Time,
-            false,
-        ),
+        Column::extra("encode time", "encode_seconds", Format::Time, false),
         Column::new("gather time", Measure::Seconds, Format::Time, false),
-        Column::new(
+        Column::extra(
             "gather / dense mat-vec",
-            Measure::extra("gather_over_dense"),
+            "gather_over_dense",
             Format::Fixed,
             false,
         ),

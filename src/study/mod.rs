@@ -222,6 +222,11 @@ impl Column {
         Column::new(header, Measure::error(quantity, metric), format, ratio)
     }
 
+    /// A column of an extra measure (`Setting::extra[name]`).
+    pub fn extra(header: &str, name: &str, format: Format, ratio: bool) -> Self {
+        Column::new(header, Measure::extra(name), format, ratio)
+    }
+
     /// The RMS relative error of the gathered light, with a ratio column: every scene sweep's
     /// headline number.
     pub fn gathered_light(header: &str) -> Self {

@@ -287,7 +287,7 @@ pub fn patch_sweep(scene: &Scene, cfg: &RadiosityConfig, progress: &dyn Progress
     // Baseline: the middle setting (the bundled pipeline's size in the full study).
     sweep.baseline = sweep.settings[(sweep.settings.len() - 1) / 2].label.clone();
     sweep.columns = vec![
-        Column::new("patches", Measure::extra("patches"), Format::Count, false),
+        Column::extra("patches", "patches", Format::Count, false),
         Column::gathered_light("B rms rel"),
         Column::error("B mean abs", "gathered_light", "mean", Format::Sci, false),
         Column::error("B max abs", "gathered_light", "max", Format::Sci, false),
@@ -394,7 +394,7 @@ pub fn estimator_sweep(
         .map(|m| m.3.clone())
         .unwrap();
     sweep.columns = vec![
-        Column::new("rays", Measure::extra("rays"), Format::Count, false),
+        Column::extra("rays", "rays", Format::Count, false),
         Column::gathered_light("B rms rel"),
         Column::error("F mean abs", "form_factors", "mean", Format::Sci, false),
         Column::error("F max abs", "form_factors", "max", Format::Sci, false),
@@ -488,7 +488,7 @@ pub fn bounce_sweep(
     sweep.columns = vec![
         Column::error("B rms rel", "gathered_light", "rms_rel", Format::Sci, true),
         Column::error("B max abs", "gathered_light", "max", Format::Sci, false),
-        Column::new("GEMMs", Measure::extra("products"), Format::Count, false),
+        Column::extra("GEMMs", "products", Format::Count, false),
         Column::new("time", Measure::Seconds, Format::Time, true),
     ];
     sweep.notes.push(

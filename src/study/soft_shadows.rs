@@ -150,19 +150,9 @@ pub fn soft_shadow_sweep(
     sweep.columns = vec![
         Column::error("mean error", "lit_fraction", "mean", Format::Sci, false),
         Column::error("max error", "lit_fraction", "max", Format::Sci, false),
-        Column::new(
-            "in penumbra",
-            Measure::extra("penumbra_fraction"),
-            Format::Percent,
-            false,
-        ),
+        Column::extra("in penumbra", "penumbra_fraction", Format::Percent, false),
         Column::new("time", Measure::Seconds, Format::Time, true),
-        Column::new(
-            "µs/pixel",
-            Measure::extra("us_per_pixel"),
-            Format::Fixed,
-            false,
-        ),
+        Column::extra("µs/pixel", "us_per_pixel", Format::Fixed, false),
         Column::new("bytes", Measure::Bytes, Format::Bytes, false),
     ];
     sweep.notes.push(

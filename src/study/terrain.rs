@@ -186,31 +186,11 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
             Format::Count,
             false,
         ),
-        Column::new(
-            "in shadow",
-            Measure::extra("shadowed_fraction"),
-            Format::Percent,
-            false,
-        ),
+        Column::extra("in shadow", "shadowed_fraction", Format::Percent, false),
         Column::new("time", Measure::Seconds, Format::Time, true),
-        Column::new(
-            "Mpx/s (wall)",
-            Measure::extra("mpixels_per_second"),
-            Format::Fixed,
-            false,
-        ),
-        Column::new(
-            "speed-up (wall)",
-            Measure::extra("speedup_wall"),
-            Format::Fixed,
-            false,
-        ),
-        Column::new(
-            "speed-up (CPU)",
-            Measure::extra("speedup_cpu"),
-            Format::Fixed,
-            false,
-        ),
+        Column::extra("Mpx/s (wall)", "mpixels_per_second", Format::Fixed, false),
+        Column::extra("speed-up (wall)", "speedup_wall", Format::Fixed, false),
+        Column::extra("speed-up (CPU)", "speedup_cpu", Format::Fixed, false),
         Column::new("bytes", Measure::Bytes, Format::Bytes, false),
     ];
     hard.notes.push(
@@ -230,8 +210,8 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
         .map(|s| s.label.clone())
         .unwrap_or_default();
     mip_sweep.columns = vec![
-        Column::new("pixels", Measure::extra("pixels"), Format::Count, true),
-        Column::new("levels", Measure::extra("levels"), Format::Count, false),
+        Column::extra("pixels", "pixels", Format::Count, true),
+        Column::extra("levels", "levels", Format::Count, false),
         Column::new("bytes", Measure::Bytes, Format::Bytes, true),
         Column::new("build time", Measure::Seconds, Format::Time, true),
     ];
