@@ -2,6 +2,9 @@
 //! box and Puget Sound 2K at 640x480 and 1920x1080. On Mesa's lavapipe/llvmpipe these "GPU"
 //! times are CPU times of a software rasteriser, not GPU times.
 //!
+//! The terrain frame is one render pass with the relief shadows traced per pixel inside it: the
+//! shadows' cost is the difference between the "shadows" and "no shadows" rows.
+//!
 //! `cargo bench --bench player_frames [-- --frames N]`
 
 use relume::bake::{run_pipeline, BakeOptions};
@@ -44,11 +47,18 @@ fn main() {
     for (pipeline, configs) in [
         (
             "pipelines/cornell.ron",
-            vec![("emitter + sun, shadows", false)],
+            vec![
+                ("emitter + sun, shadows", Some(false)),
+                ("emitter + sun, no shadows", None),
+            ],
         ),
         (
             "pipelines/puget-sound-2k.ron",
-            vec![("hard shadows", false), ("soft shadows", true)],
+            vec![
+                ("no shadows", None),
+                ("hard shadows", Some(false)),
+                ("soft shadows", Some(true)),
+            ],
         ),
     ] {
         let p = parse_pipeline(&root.join(pipeline)).expect("pipeline");
@@ -59,8 +69,10 @@ fn main() {
                 Player::load(&gpu, &dir, &PlayerOptions::default(), w, h).expect("load");
             let camera = player.default_camera();
             for (label, soft) in &configs {
+                // None: no shadows; Some(soft): hard or soft shadows.
                 let s = FrameSettings {
-                    soft_shadows: *soft,
+                    shadows: soft.is_some(),
+                    soft_shadows: soft.unwrap_or(false),
                     exposure: 2.0,
                     ..Default::default()
                 };
