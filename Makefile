@@ -35,7 +35,7 @@ demo: build
 	    --out out/demo/puget-sound-lit.png --shaded out/demo/puget-sound-soft-relief.png
 	@mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
 	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --out out/demo/cornell-frames
-	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --sun 0,25 --frames 4 \
+	$(PLAYER) out/demo/cornell --headless --exposure 1 --size 640x480 --sun 20,30 --frames 4 \
 	    --out out/demo/cornell-sun-frames
 	$(PLAYER) out/demo/puget-sound-2k --headless --size 640x480 --sun 300,6 --frames 2 \
 	    --out out/demo/puget-sound-frames
@@ -48,7 +48,7 @@ demo: build
 	@echo "  puget-sound-shadow.png, puget-sound-relief.png hard shadows (CPU, 4K, sun 300°/10°)"
 	@echo "  puget-sound-lit.png, puget-sound-soft-relief.png  soft shadows (CPU, 4K, sun 300°/3°)"
 	@echo "  cornell-frames/frame_0000.png                  player: the Cornell box lit by its ceiling light"
-	@echo "  cornell-sun-frames/frame_000[0-3].png          player: plus a sun turning around it (0°, 90°, 180°, 270°)"
+	@echo "  cornell-sun-frames/frame_000[0-3].png          player: plus a sun turning around it (20°, 110°, 200°, 290°)"
 	@echo "  puget-sound-frames/frame_000[0-1].png          player: Puget Sound 2K, hard relief shadows"
 	@echo "  puget-sound-soft-frames/frame_0000.png         player: Puget Sound 2K, soft shadows"
 	@echo "  */frames.json                                  adapter and per-pass frame times"
