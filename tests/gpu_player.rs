@@ -330,3 +330,102 @@ fn player_cli_writes_frames_and_timings_and_reports_bad_input() {
     let o = run(&[dir.to_str().unwrap(), "--headless", "--size", "0x10"]);
     assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
 }
+
+/// Mean 8-bit luminance of the 9x9 pixels around (fx·width, fy·height).
+fn patch_luma(img: &image::RgbaImage, fx: f32, fy: f32) -> f64 {
+    let (cx, cy) = (
+        (fx * img.width() as f32) as i64,
+        (fy * img.height() as f32) as i64,
+    );
+    let mut sum = 0.0;
+    for y in cy - 4..=cy + 4 {
+        for x in cx - 4..=cx + 4 {
+            let p = img.get_pixel(x as u32, y as u32);
+            sum += 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+        }
+    }
+    sum / 81.0
+}
+
+#[test]
+fn command_line_lights_light_the_scene_and_the_window_opens() {
+    if gpu().is_none() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = bake_pipeline(tmp.path(), "pipelines/cornell.ron");
+    let player = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
+            .arg(&dir)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    // The camera and a narrow spot share the box's axis: the spot lights the image centre and
+    // not the image's corner region (outside its 10° cone).
+    let camera = "0.278,0.273,-0.8,0.278,0.273,0,39.3";
+    let frame = |name: &str, extra: &[&str]| {
+        let out = tmp.path().join(name);
+        let mut args = vec![
+            "--headless",
+            "--size",
+            "160x120",
+            "--camera",
+            camera,
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = player(&args);
+        assert!(o.status.success(), "{extra:?}: {}", common::text(&o));
+        image::open(out.join("frame_0000.png")).unwrap().to_rgba8()
+    };
+    let dark = frame("dark", &[]);
+    let spot = frame("spot", &["--light", "spot:0.278,0.273,-0.5:0,0,1:10:0.5"]);
+    let (centre, corner) = (
+        patch_luma(&spot, 0.5, 0.5) - patch_luma(&dark, 0.5, 0.5),
+        patch_luma(&spot, 0.12, 0.12) - patch_luma(&dark, 0.12, 0.12),
+    );
+    eprintln!("spot: centre +{centre:.1}, corner +{corner:.1} (8-bit luma)");
+    assert!(centre > 30.0, "the spot adds only {centre} to the centre");
+    assert!(
+        corner < 0.2 * centre,
+        "outside the cone: +{corner} (centre +{centre})"
+    );
+    // A point light and a directional light render too; bad specs are usage errors (2), and
+    // punctual lights on a height-map bake are refused (3).
+    frame(
+        "more",
+        &[
+            "--light",
+            "point:0.28,0.4,0.2:0.05:1,0.8,0.6",
+            "--light",
+            "dir:0,-1,1",
+        ],
+    );
+    let o = player(&["--headless", "--light", "point:0,0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
+    assert!(common::text(&o).contains("three comma-separated numbers"));
+
+    // The window, under a virtual X server when there is one (make test installs xvfb).
+    let xvfb = std::process::Command::new("xvfb-run")
+        .arg("--help")
+        .output();
+    if xvfb.is_err() {
+        eprintln!("SKIP window test: xvfb-run not found (apt-get install xvfb xauth)");
+        return;
+    }
+    let o = std::process::Command::new("xvfb-run")
+        .args(["-a", env!("CARGO_BIN_EXE_relume-player")])
+        .arg(&dir)
+        .args(["--size", "160x120", "--exit-after", "3", "--sun", "20,30"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "window: {}", common::text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("showed 3 frame(s) in a window"),
+        "{}",
+        common::text(&o)
+    );
+}

@@ -9,9 +9,11 @@ use relume::error::{exit, Error, Result};
 use relume::gpu::compressed_gather::DecodePath;
 use relume::gpu::timing::PassTimer;
 use relume::gpu::{BackendChoice, Gpu};
+use relume::player::light_spec::parse_light;
 use relume::player::{FrameTimes, Player, PlayerOptions, Sun, TransportChoice};
 use relume::render::camera::Camera;
 use relume::render::mesh_reference::FrameSettings;
+use relume::scene::Light;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -43,6 +45,15 @@ struct Cli {
     /// Sun azimuth (degrees clockwise from north) and elevation (degrees), e.g. 135,30
     #[arg(long, value_name = "AZ,EL", value_parser = parse_sun, allow_hyphen_values = true)]
     sun: Option<Sun>,
+    /// Add a punctual light (repeatable): point:X,Y,Z[:I[:R,G,B]],
+    /// spot:X,Y,Z:DX,DY,DZ:ANGLE[:I[:R,G,B]] or dir:DX,DY,DZ[:I[:R,G,B]] — scene units, intensity
+    /// in candela (point, spot; default 1) or lux (dir; default 3), ANGLE the cone's half-angle
+    /// in degrees
+    #[arg(long, value_name = "SPEC", value_parser = parse_light, allow_hyphen_values = true)]
+    light: Vec<Light>,
+    /// Window: close after N frames (for scripts and tests)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    exit_after: Option<u32>,
     /// Camera: eye x,y,z, target x,y,z and optionally the vertical field of view in degrees
     #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]", value_parser = parse_camera, allow_hyphen_values = true)]
     camera: Option<Camera>,
@@ -221,15 +232,17 @@ fn backend(cli: &Cli) -> Option<BackendChoice> {
 
 fn run(cli: &Cli) -> Result<()> {
     if !cli.headless {
-        return window::run(
-            cli.baked_dir.clone(),
-            cli.size,
-            cli.sun,
-            cli.camera,
-            settings(cli),
-            backend(cli),
-            player_options(cli),
-        );
+        return window::run(window::WindowPlan {
+            dir: cli.baked_dir.clone(),
+            size: cli.size,
+            sun: cli.sun,
+            camera: cli.camera,
+            settings: settings(cli),
+            backend: backend(cli),
+            options: player_options(cli),
+            lights: cli.light.clone(),
+            exit_after: cli.exit_after,
+        });
     }
     let gpu = Gpu::new(backend(cli))?;
     if !cli.quiet {
@@ -240,6 +253,7 @@ fn run(cli: &Cli) -> Result<()> {
     }
     let (w, h) = cli.size;
     let mut player = Player::load(&gpu, &cli.baked_dir, &player_options(cli), w, h)?;
+    player.add_lights(&gpu, &cli.light)?;
     let camera = cli.camera.unwrap_or_else(|| player.default_camera());
     let s = settings(cli);
     std::fs::create_dir_all(&cli.out)

@@ -86,6 +86,13 @@ impl MeshPlayer {
         self.upload_lights(gpu)
     }
 
+    /// Add punctual lights to the scene's own (always on).
+    pub fn add_lights(&mut self, gpu: &Gpu, lights: &[Light]) -> Result<()> {
+        self.scene_lights
+            .extend(lights.iter().map(|l| GpuLight::from_light(l, 1.0, 0)));
+        self.upload_lights(gpu)
+    }
+
     fn upload_lights(&mut self, gpu: &Gpu) -> Result<()> {
         let mut all = self.scene_lights.clone();
         all.extend(self.sun);

@@ -1,6 +1,7 @@
 //! The runtime: load a baked directory and render frames with wgpu. The binary
 //! (`relume-player`) only parses arguments and runs the window or headless loop around this.
 
+pub mod light_spec;
 mod mesh;
 mod terrain;
 
@@ -96,6 +97,20 @@ impl Player {
         match self {
             Player::Mesh(m) => m.default_camera(),
             Player::Terrain(t) => t.default_camera(),
+        }
+    }
+
+    /// Add punctual lights to a mesh scene's own (e.g. from `--light`). Terrain is lit by the
+    /// sun alone: lights there are refused.
+    pub fn add_lights(&mut self, gpu: &Gpu, lights: &[crate::scene::Light]) -> Result<()> {
+        if lights.is_empty() {
+            return Ok(());
+        }
+        match self {
+            Player::Mesh(m) => m.add_lights(gpu, lights),
+            Player::Terrain(_) => Err(crate::error::Error::knob(
+                "punctual lights (--light) light mesh bakes; a height-map bake is lit by the sun (--sun)",
+            )),
         }
     }
 

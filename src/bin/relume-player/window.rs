@@ -7,6 +7,7 @@ use relume::gpu::{BackendChoice, Gpu};
 use relume::player::{Player, PlayerOptions, Sun};
 use relume::render::camera::Camera;
 use relume::render::mesh_reference::FrameSettings;
+use relume::scene::Light;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -61,6 +62,21 @@ struct Running {
     frame_ms: f64,
 }
 
+/// What the window shows, from the command line.
+pub struct WindowPlan {
+    pub dir: PathBuf,
+    pub size: (u32, u32),
+    pub sun: Option<Sun>,
+    pub camera: Option<Camera>,
+    pub settings: FrameSettings,
+    pub backend: Option<BackendChoice>,
+    pub options: PlayerOptions,
+    /// Punctual lights added to the scene's (`--light`).
+    pub lights: Vec<Light>,
+    /// Close the window after this many frames (`--exit-after`; scripts and tests).
+    pub exit_after: Option<u32>,
+}
+
 struct App {
     dir: PathBuf,
     size: (u32, u32),
@@ -70,6 +86,9 @@ struct App {
     settings: FrameSettings,
     backend: Option<BackendChoice>,
     options: PlayerOptions,
+    lights: Vec<Light>,
+    exit_after: Option<u32>,
+    frames: u32,
     running: Option<Running>,
     error: Option<Error>,
     dragging: Option<(f64, f64)>,
@@ -77,15 +96,18 @@ struct App {
 }
 
 /// Open a window on the bake at `dir` and run until it is closed.
-pub fn run(
-    dir: PathBuf,
-    size: (u32, u32),
-    sun: Option<Sun>,
-    camera: Option<Camera>,
-    settings: FrameSettings,
-    backend: Option<BackendChoice>,
-    options: PlayerOptions,
-) -> Result<()> {
+pub fn run(plan: WindowPlan) -> Result<()> {
+    let WindowPlan {
+        dir,
+        size,
+        sun,
+        camera,
+        settings,
+        backend,
+        options,
+        lights,
+        exit_after,
+    } = plan;
     let event_loop = EventLoop::new().map_err(|e| {
         Error::Gpu(format!(
             "cannot open a window ({e}); without a display use --headless"
@@ -103,6 +125,9 @@ pub fn run(
         settings,
         backend,
         options,
+        lights,
+        exit_after,
+        frames: 0,
         running: None,
         error: None,
         dragging: None,
@@ -162,7 +187,12 @@ impl App {
         };
         surface.configure(&gpu.device, &config);
         let mut player = Player::load(&gpu, &self.dir, &self.options, config.width, config.height)?;
+        player.add_lights(&gpu, &self.lights)?;
         player.set_sun(&gpu, self.sun_on.then_some(self.sun))?;
+        eprintln!(
+            "adapter: {} ({}, {})",
+            gpu.info.name, gpu.info.backend, gpu.info.device_type
+        );
         let orbit = Orbit::from_camera(&self.camera.unwrap_or_else(|| player.default_camera()));
         let blit = Blit::new(&gpu, format)?;
         let timer = PassTimer::new(&gpu, 48);
@@ -180,9 +210,10 @@ impl App {
         })
     }
 
-    fn redraw(&mut self) -> Result<()> {
+    /// Draw one frame; true when `--exit-after` frames have been shown.
+    fn redraw(&mut self) -> Result<bool> {
         let Some(r) = self.running.as_mut() else {
-            return Ok(());
+            return Ok(false);
         };
         let t0 = Instant::now();
         r.player
@@ -192,7 +223,8 @@ impl App {
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             _ => {
                 r.surface.configure(&r.gpu.device, &r.config);
-                return Ok(());
+                r.window.request_redraw();
+                return Ok(false);
             }
         };
         let view = frame.texture.create_view(&Default::default());
@@ -215,7 +247,8 @@ impl App {
             ));
         }
         r.window.request_redraw();
-        Ok(())
+        self.frames += 1;
+        Ok(self.exit_after.is_some_and(|n| self.frames >= n))
     }
 
     fn key(&mut self, key: &Key) -> Result<bool> {
@@ -312,7 +345,15 @@ impl ApplicationHandler for App {
                     Ok(())
                 }
             }
-            WindowEvent::RedrawRequested => self.redraw(),
+            WindowEvent::RedrawRequested => match self.redraw() {
+                Ok(true) => {
+                    eprintln!("showed {} frame(s) in a window", self.frames);
+                    el.exit();
+                    Ok(())
+                }
+                Ok(false) => Ok(()),
+                Err(e) => Err(e),
+            },
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
                 match self.key(&event.logical_key) {
                     Ok(true) => {
