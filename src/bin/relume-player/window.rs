@@ -78,16 +78,10 @@ pub struct WindowPlan {
 }
 
 struct App {
-    dir: PathBuf,
-    size: (u32, u32),
+    plan: WindowPlan,
+    /// The sun the keys move (shown when `sun_on`).
     sun: Sun,
     sun_on: bool,
-    camera: Option<Camera>,
-    settings: FrameSettings,
-    backend: Option<BackendChoice>,
-    options: PlayerOptions,
-    lights: Vec<Light>,
-    exit_after: Option<u32>,
     frames: u32,
     running: Option<Running>,
     error: Option<Error>,
@@ -97,36 +91,18 @@ struct App {
 
 /// Open a window on the bake at `dir` and run until it is closed.
 pub fn run(plan: WindowPlan) -> Result<()> {
-    let WindowPlan {
-        dir,
-        size,
-        sun,
-        camera,
-        settings,
-        backend,
-        options,
-        lights,
-        exit_after,
-    } = plan;
     let event_loop = EventLoop::new().map_err(|e| {
         Error::Gpu(format!(
             "cannot open a window ({e}); without a display use --headless"
         ))
     })?;
     let mut app = App {
-        dir,
-        size,
-        sun: sun.unwrap_or(Sun {
+        sun: plan.sun.unwrap_or(Sun {
             azimuth_deg: 135.0,
             elevation_deg: 35.0,
         }),
-        sun_on: sun.is_some(),
-        camera,
-        settings,
-        backend,
-        options,
-        lights,
-        exit_after,
+        sun_on: plan.sun.is_some(),
+        plan,
         frames: 0,
         running: None,
         error: None,
@@ -146,13 +122,16 @@ impl App {
     fn start(&mut self, el: &ActiveEventLoop) -> Result<Running> {
         let attrs = Window::default_attributes()
             .with_title("relume-player")
-            .with_inner_size(winit::dpi::PhysicalSize::new(self.size.0, self.size.1));
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                self.plan.size.0,
+                self.plan.size.1,
+            ));
         let window = Arc::new(
             el.create_window(attrs)
                 .map_err(|e| Error::Gpu(format!("cannot create a window: {e}")))?,
         );
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        if let Some(b) = self.backend {
+        if let Some(b) = self.plan.backend {
             desc.backends = match b {
                 BackendChoice::Vulkan => wgpu::Backends::VULKAN,
                 BackendChoice::Gl => wgpu::Backends::GL,
@@ -186,14 +165,21 @@ impl App {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&gpu.device, &config);
-        let mut player = Player::load(&gpu, &self.dir, &self.options, config.width, config.height)?;
-        player.add_lights(&gpu, &self.lights)?;
+        let mut player = Player::load(
+            &gpu,
+            &self.plan.dir,
+            &self.plan.options,
+            config.width,
+            config.height,
+        )?;
+        player.add_lights(&gpu, &self.plan.lights)?;
         player.set_sun(&gpu, self.sun_on.then_some(self.sun))?;
         eprintln!(
             "adapter: {} ({}, {})",
             gpu.info.name, gpu.info.backend, gpu.info.device_type
         );
-        let orbit = Orbit::from_camera(&self.camera.unwrap_or_else(|| player.default_camera()));
+        let orbit =
+            Orbit::from_camera(&self.plan.camera.unwrap_or_else(|| player.default_camera()));
         let blit = Blit::new(&gpu, format)?;
         let timer = PassTimer::new(&gpu, 48);
         Ok(Running {
@@ -217,7 +203,7 @@ impl App {
         };
         let t0 = Instant::now();
         r.player
-            .render(&r.gpu, &r.orbit.camera(), &self.settings, &mut r.timer)?;
+            .render(&r.gpu, &r.orbit.camera(), &self.plan.settings, &mut r.timer)?;
         let frame = match r.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f)
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -233,7 +219,7 @@ impl App {
         r.frame_ms = 0.9 * r.frame_ms + 0.1 * t0.elapsed().as_secs_f64() * 1e3;
         if r.last.elapsed().as_millis() > 250 {
             r.last = Instant::now();
-            let s = &self.settings;
+            let s = &self.plan.settings;
             r.window.set_title(&format!(
                 "relume-player — {:.1} ms/frame — sun {:.0}°/{:.0}°{} — direct {} indirect {} shadows {} emission {}",
                 r.frame_ms,
@@ -248,7 +234,7 @@ impl App {
         }
         r.window.request_redraw();
         self.frames += 1;
-        Ok(self.exit_after.is_some_and(|n| self.frames >= n))
+        Ok(self.plan.exit_after.is_some_and(|n| self.frames >= n))
     }
 
     fn key(&mut self, key: &Key) -> Result<bool> {
@@ -284,14 +270,14 @@ impl App {
                         ((self.sun.elevation_deg - 2.0).max(-10.0), true)
                 }
                 "s" | "S" => (self.sun_on, sun_changed) = (!self.sun_on, true),
-                "1" => self.settings.direct = !self.settings.direct,
-                "2" => self.settings.indirect = !self.settings.indirect,
-                "3" => self.settings.shadows = !self.settings.shadows,
-                "4" => self.settings.emission = !self.settings.emission,
-                "5" => self.settings.soft_shadows = !self.settings.soft_shadows,
-                "6" => self.settings.fog = !self.settings.fog,
-                "[" => self.settings.exposure /= 1.25,
-                "]" => self.settings.exposure *= 1.25,
+                "1" => self.plan.settings.direct = !self.plan.settings.direct,
+                "2" => self.plan.settings.indirect = !self.plan.settings.indirect,
+                "3" => self.plan.settings.shadows = !self.plan.settings.shadows,
+                "4" => self.plan.settings.emission = !self.plan.settings.emission,
+                "5" => self.plan.settings.soft_shadows = !self.plan.settings.soft_shadows,
+                "6" => self.plan.settings.fog = !self.plan.settings.fog,
+                "[" => self.plan.settings.exposure /= 1.25,
+                "]" => self.plan.settings.exposure *= 1.25,
                 _ => {}
             },
             _ => {}
