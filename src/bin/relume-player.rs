@@ -23,7 +23,8 @@ Exit codes: 0 success, 1 internal error, 2 usage, 3 invalid input, 4 I/O, 6 unsu
 (including: no GPU adapter — install mesa-vulkan-drivers), 7 the bake failed verification.
 
 Window keys: mouse drag or arrows orbit, wheel or +/- zoom, J/L sun azimuth, I/K sun elevation,
-1 direct, 2 indirect, 3 shadows, 4 emission on/off, [ ] exposure, Esc quit.";
+S sun on/off, 1 direct, 2 indirect, 3 shadows, 4 emission, 5 soft shadows, 6 fog, [ ] exposure,
+Esc quit.";
 
 #[derive(Parser)]
 #[command(name = "relume-player", version, about = "Render baked relume scenes and terrain with wgpu", after_help = EXIT_CODES)]
