@@ -17,7 +17,13 @@ pub enum LoadedInput {
 pub fn load_input(input: &Input) -> Result<LoadedInput> {
     match input {
         Input::Scene(s) => {
-            let (scene, warnings) = load_scene(&s.path, s.options())?;
+            let (mut scene, warnings) = load_scene(&s.path, s.options())?;
+            for (k, l) in s.lights.iter().enumerate() {
+                let light = l
+                    .to_light(&format!("pipeline light {k}"))
+                    .map_err(Error::knob)?;
+                scene.lights.push(light);
+            }
             Ok(LoadedInput::Scene(scene, warnings))
         }
         Input::HeightMap(h) => {

@@ -429,3 +429,78 @@ fn command_line_lights_light_the_scene_and_the_window_opens() {
         common::text(&o)
     );
 }
+
+#[test]
+fn pipeline_lights_reach_the_bake_and_the_player() {
+    let tmp = tempfile::tempdir().unwrap();
+    let obj = data("scenes/cornell-box/cornell_box.obj");
+    let write = |name: &str, lights: &str| {
+        let p = tmp.path().join(name);
+        std::fs::write(
+            &p,
+            format!(
+                "Pipeline(input: Scene(path: {obj:?}, scale: 0.001, lights: [{lights}]), \
+                 stages: [Voxelize(resolution: TargetPatches(60)), FormFactors(samples: 256), Transport()])"
+            ),
+        )
+        .unwrap();
+        p
+    };
+    // Out-of-range light knobs are located errors (exit 3) and bake nothing.
+    let bad = write(
+        "bad.ron",
+        "Spot(position: (0, 0, 0), direction: (0, 0, 1), angle: 120)",
+    );
+    let o = bake(
+        tmp.path(),
+        &["run", "-q", bad.to_str().unwrap(), "--out", "bad"],
+    );
+    let err = expect_code(&o, 3);
+    assert!(
+        err.contains("bad.ron:1:") && err.contains("(0, 90]"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("bad").exists());
+
+    let spot =
+        "Spot(position: (0.278, 0.273, -0.5), direction: (0, 0, 1), angle: 10, intensity: 0.5)";
+    let mut frames = Vec::new();
+    for (name, lights) in [("plain", ""), ("lit", spot)] {
+        let p = write(&format!("{name}.ron"), lights);
+        let out = tmp.path().join(name);
+        expect_code(
+            &bake(
+                tmp.path(),
+                &[
+                    "run",
+                    "-q",
+                    p.to_str().unwrap(),
+                    "--out",
+                    out.to_str().unwrap(),
+                ],
+            ),
+            0,
+        );
+        let scene: relume::scene::Scene = relume::baked::read_scene(&out).unwrap();
+        assert_eq!(scene.lights.len(), usize::from(name == "lit"));
+        if gpu().is_none() {
+            return;
+        }
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
+            .arg(&out)
+            .args(["--headless", "--size", "160x120", "-q", "--out"])
+            .arg(out.join("frames"))
+            .args(["--camera", "0.278,0.273,-0.8,0.278,0.273,0,39.3"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", common::text(&o));
+        frames.push(
+            image::open(out.join("frames/frame_0000.png"))
+                .unwrap()
+                .to_rgba8(),
+        );
+    }
+    let centre = patch_luma(&frames[1], 0.5, 0.5) - patch_luma(&frames[0], 0.5, 0.5);
+    eprintln!("pipeline spot: centre +{centre:.1}");
+    assert!(centre > 30.0, "the pipeline's spot adds only {centre}");
+}

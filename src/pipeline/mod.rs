@@ -59,6 +59,14 @@ pub struct SceneInput {
     /// Factor applied to all positions (0.001 turns millimetres into metres). Default 1.
     #[serde(default = "one", deserialize_with = "parse::positive_f32")]
     pub scale: f32,
+    /// Punctual lights added to the scene's own, in world units (after `scale`); the player
+    /// lights the scene with them every frame (the baked transport does not depend on them).
+    #[serde(
+        default,
+        deserialize_with = "parse::lights",
+        skip_serializing_if = "Vec::is_empty"
+    )]
+    pub lights: Vec<crate::scene::punctual::LightSpec>,
 }
 
 /// Knobs of a height-map input.

@@ -180,6 +180,19 @@ fn check<'de, D: Deserializer<'de>, T>(
     }
 }
 
+/// Punctual lights, each checked by [`crate::scene::punctual::LightSpec::to_light`].
+pub fn lights<'de, D: Deserializer<'de>>(
+    d: D,
+) -> Result<Vec<crate::scene::punctual::LightSpec>, D::Error> {
+    let v = Vec::<crate::scene::punctual::LightSpec>::deserialize(d)?;
+    for (k, l) in v.iter().enumerate() {
+        if let Err(e) = l.to_light("") {
+            return Err(serde::de::Error::custom(format!("light {k}: {e}")));
+        }
+    }
+    Ok(v)
+}
+
 /// A finite f32 greater than zero.
 pub fn positive_f32<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     let v = f32::deserialize(d)?;

@@ -7,76 +7,52 @@
 //! - `dir:DX,DY,DZ[:INTENSITY[:R,G,B]]` — the direction the light travels; lux, default 3 (the
 //!   player's sun).
 //!
-//! Colours are linear RGB, default white.
+//! Colours are linear RGB, default white. The values are checked by
+//! [`LightSpec::to_light`], as for lights declared in a pipeline.
 
-use crate::scene::{Light, LightKind};
+use crate::scene::punctual::LightSpec;
+use crate::scene::Light;
 
 /// Parse one `--light` value. The error says what is wrong and shows the expected form.
 pub fn parse_light(spec: &str) -> std::result::Result<Light, String> {
     let parts: Vec<&str> = spec.split(':').collect();
     let forms = "expected point:X,Y,Z[:I[:R,G,B]], spot:X,Y,Z:DX,DY,DZ:ANGLE[:I[:R,G,B]] or dir:DX,DY,DZ[:I[:R,G,B]]";
-    let (kind, fixed) = match parts[0] {
-        "point" => ("point", 2),
-        "spot" => ("spot", 4),
-        "dir" | "directional" => ("dir", 2),
+    let fixed = match parts[0] {
+        "point" | "dir" | "directional" => 2,
+        "spot" => 4,
         other => return Err(format!("unknown light kind `{other}`: {forms}")),
     };
     if parts.len() < fixed || parts.len() > fixed + 2 {
         return Err(format!("`{spec}` has {} fields: {forms}", parts.len()));
     }
-    let intensity = match parts.get(fixed) {
-        Some(s) => {
-            let v = number(s, "intensity")?;
-            if v < 0.0 {
-                return Err(format!("intensity must be ≥ 0, got {v}"));
-            }
-            v
-        }
-        None if kind == "dir" => 3.0,
-        None => 1.0,
-    };
+    let intensity = parts
+        .get(fixed)
+        .map(|s| number(s, "intensity"))
+        .transpose()?;
     let color = match parts.get(fixed + 1) {
-        Some(s) => {
-            let c = triple(s, "colour")?;
-            if c.iter().any(|v| *v < 0.0) {
-                return Err(format!("colour components must be ≥ 0, got `{s}`"));
-            }
-            c
-        }
+        Some(s) => triple(s, "colour")?,
         None => [1.0; 3],
     };
-    let mut light = Light {
-        name: format!("--light {spec}"),
-        kind: LightKind::Point,
-        position: [0.0; 3],
-        direction: [0.0, -1.0, 0.0],
-        color,
-        intensity,
-        range: None,
+    let light = match parts[0] {
+        "point" => LightSpec::Point {
+            position: triple(parts[1], "position")?,
+            intensity: intensity.unwrap_or(1.0),
+            color,
+        },
+        "spot" => LightSpec::Spot {
+            position: triple(parts[1], "position")?,
+            direction: triple(parts[2], "direction")?,
+            angle: number(parts[3], "cone angle")?,
+            intensity: intensity.unwrap_or(1.0),
+            color,
+        },
+        _ => LightSpec::Directional {
+            direction: triple(parts[1], "direction")?,
+            intensity: intensity.unwrap_or(3.0),
+            color,
+        },
     };
-    match kind {
-        "point" => light.position = triple(parts[1], "position")?,
-        "spot" => {
-            light.position = triple(parts[1], "position")?;
-            light.direction = unit(parts[2])?;
-            let angle = number(parts[3], "cone angle")?;
-            if !(angle > 0.0 && angle <= 90.0) {
-                return Err(format!(
-                    "the spot's cone half-angle must be in (0, 90] degrees, got {angle}"
-                ));
-            }
-            let outer = angle.to_radians();
-            light.kind = LightKind::Spot {
-                inner_cone: 0.8 * outer,
-                outer_cone: outer,
-            };
-        }
-        _ => {
-            light.kind = LightKind::Directional;
-            light.direction = unit(parts[1])?;
-        }
-    }
-    Ok(light)
+    light.to_light(&format!("--light {spec}"))
 }
 
 fn number(s: &str, what: &str) -> std::result::Result<f32, String> {
@@ -98,18 +74,10 @@ fn triple(s: &str, what: &str) -> std::result::Result<[f32; 3], String> {
     ])
 }
 
-fn unit(s: &str) -> std::result::Result<[f32; 3], String> {
-    let d = glam::Vec3::from(triple(s, "direction")?);
-    let len = d.length();
-    if len <= 1e-12 || !len.is_finite() {
-        return Err(format!("direction `{s}` has no length"));
-    }
-    Ok((d / len).to_array())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::LightKind;
 
     #[test]
     fn parses_every_kind_with_defaults() {

@@ -8,6 +8,7 @@
 
 mod gltf_loader;
 mod obj_loader;
+pub mod punctual;
 
 use crate::error::{Error, Result};
 use glam::Vec3;
