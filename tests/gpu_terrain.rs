@@ -134,7 +134,7 @@ fn map_view_matches_the_cpu_shading() {
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     r.record(&gpu, &mut enc, view_proj, eye, &s, &mut timer);
     gpu.queue.submit([enc.finish()]);
-    let img = r.read_image(&gpu).unwrap();
+    let img = r.target.read_image(&gpu).unwrap();
     let shadow: Vec<f32> = r
         .shadow_mask(&gpu, true)
         .unwrap()

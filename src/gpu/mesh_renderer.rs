@@ -2,6 +2,7 @@
 //! light), then `mesh_shade.wgsl` (direct per pixel + indirect per corner + emission, tone map)
 //! into an RGBA8 target. The CPU twin is `relume::render::mesh_reference`.
 
+use super::render_target::{RenderTarget, DEPTH_FORMAT, TARGET_FORMAT};
 use super::timing::PassTimer;
 use super::Gpu;
 use crate::error::{Error, Result};
@@ -33,10 +34,6 @@ struct FrameUniform {
     pad: u32,
 }
 
-/// Colour format of the render target (tone mapping and sRGB encoding happen in the shader).
-pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-
 /// GPU state for drawing one mesh scene.
 pub struct MeshRenderer {
     shade: wgpu::RenderPipeline,
@@ -56,12 +53,8 @@ pub struct MeshRenderer {
     /// Group 1 for the shadow passes: the lights uniform only (the maps are being written).
     shadow_group1: wgpu::BindGroup,
     pub group1_layout: wgpu::BindGroupLayout,
-    target: wgpu::Texture,
-    target_view: wgpu::TextureView,
-    depth_view: wgpu::TextureView,
+    pub target: RenderTarget,
     bounds: (glam::Vec3, f32),
-    pub width: u32,
-    pub height: u32,
 }
 
 impl MeshRenderer {
@@ -220,7 +213,6 @@ impl MeshRenderer {
             }],
         });
         let (shade, shadow) = pipelines(gpu, &group0_layout, &group1_layout, &lights_only_layout)?;
-        let (target, target_view, depth_view) = targets(gpu, width, height);
         let (lo, hi) = scene.bounds();
         Ok(MeshRenderer {
             shade,
@@ -237,12 +229,8 @@ impl MeshRenderer {
             group1,
             shadow_group1,
             group1_layout,
-            target,
-            target_view,
-            depth_view,
+            target: RenderTarget::new(gpu, width, height),
             bounds: ((lo + hi) * 0.5, ((hi - lo) * 0.5).length()),
-            width,
-            height,
         })
     }
 
@@ -335,7 +323,7 @@ impl MeshRenderer {
     ) {
         let f = FrameUniform {
             view_proj: camera
-                .view_projection(self.width, self.height)
+                .view_projection(self.target.width, self.target.height)
                 .to_cols_array(),
             eye: camera.eye.extend(1.0).to_array(),
             exposure: s.exposure,
@@ -345,35 +333,7 @@ impl MeshRenderer {
         };
         gpu.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
-        let bg = s.background;
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shade"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.target_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: bg[0] as f64,
-                        g: bg[1] as f64,
-                        b: bg[2] as f64,
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timer.render("shade"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = self.target.begin_pass(enc, "shade", s.background, timer);
         pass.set_pipeline(&self.shade);
         pass.set_bind_group(0, &self.group0, &[]);
         pass.set_bind_group(1, &self.group1, &[]);
@@ -382,26 +342,9 @@ impl MeshRenderer {
         pass.draw(0..self.corners, 0..1);
     }
 
-    /// The render target (for presenting in a window).
-    pub fn target_view(&self) -> &wgpu::TextureView {
-        &self.target_view
-    }
-
     /// Resize the render target.
     pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
-        let (t, tv, dv) = targets(gpu, width.max(1), height.max(1));
-        self.target = t;
-        self.target_view = tv;
-        self.depth_view = dv;
-        self.width = width.max(1);
-        self.height = height.max(1);
-    }
-
-    /// The rendered image as tightly packed RGBA8 rows.
-    pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
-        let px = super::readback::read_texture_4bpp(gpu, &self.target)?;
-        image::RgbaImage::from_raw(self.width, self.height, px)
-            .ok_or_else(|| Error::Internal("readback size".into()))
+        self.target = RenderTarget::new(gpu, width, height);
     }
 }
 
@@ -539,41 +482,4 @@ fn pipelines(
         cache: None,
     });
     Ok((shade, shadow))
-}
-
-pub(crate) fn targets(
-    gpu: &Gpu,
-    width: u32,
-    height: u32,
-) -> (wgpu::Texture, wgpu::TextureView, wgpu::TextureView) {
-    let size = wgpu::Extent3d {
-        width,
-        height,
-        depth_or_array_layers: 1,
-    };
-    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("target"),
-        size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: TARGET_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::COPY_SRC
-            | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    });
-    let depth = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("depth"),
-        size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
-    let tv = target.create_view(&Default::default());
-    let dv = depth.create_view(&Default::default());
-    (target, tv, dv)
 }

@@ -11,6 +11,7 @@ pub mod compute;
 pub mod mesh_renderer;
 pub mod radiosity_runtime;
 pub mod readback;
+pub mod render_target;
 pub mod terrain_renderer;
 pub mod timing;
 

@@ -3,6 +3,7 @@
 //! `terrain::relief::shadow_mask`) and the terrain frame (`terrain_render.wgsl`, tested against
 //! `render::terrain_shading`).
 
+use super::render_target::{RenderTarget, DEPTH_FORMAT, TARGET_FORMAT};
 use super::{compute, timing::PassTimer, Gpu};
 use crate::error::{Error, Result};
 use crate::heightmap::HeightMap;
@@ -74,11 +75,7 @@ pub struct TerrainRenderer {
     indices: wgpu::Buffer,
     index_count: u32,
     grid_step: u32,
-    target: wgpu::Texture,
-    target_view: wgpu::TextureView,
-    depth_view: wgpu::TextureView,
-    pub width: u32,
-    pub height: u32,
+    pub target: RenderTarget,
     sun: Sun,
 }
 
@@ -190,7 +187,7 @@ impl TerrainRenderer {
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
-                    format: wgpu::TextureFormat::Depth32Float,
+                    format: DEPTH_FORMAT,
                     depth_write_enabled: Some(true),
                     depth_compare: Some(wgpu::CompareFunction::Less),
                     stencil: Default::default(),
@@ -201,7 +198,7 @@ impl TerrainRenderer {
                     module: &module,
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
-                    targets: &[Some(super::mesh_renderer::TARGET_FORMAT.into())],
+                    targets: &[Some(TARGET_FORMAT.into())],
                 }),
                 multiview_mask: None,
                 cache: None,
@@ -230,7 +227,6 @@ impl TerrainRenderer {
             .max(1);
         let (grid, indices, index_count) =
             grid_mesh(gpu, map.width as u32, map.height as u32, step);
-        let (target, target_view, depth_view) = super::mesh_renderer::targets(gpu, width, height);
         let (lo, hi) = map.min_max();
         let mut r = TerrainRenderer {
             map_size: (map.width as u32, map.height as u32),
@@ -249,11 +245,7 @@ impl TerrainRenderer {
             indices,
             index_count,
             grid_step: step,
-            target,
-            target_view,
-            depth_view,
-            width,
-            height,
+            target: RenderTarget::new(gpu, width, height),
             sun: Sun::new(135.0, 30.0)?,
         };
         r.params_cpu.max_height = mip.max_height;
@@ -392,35 +384,7 @@ impl TerrainRenderer {
         };
         gpu.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
-        let bg = s.background;
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("terrain"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.target_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: bg[0] as f64,
-                        g: bg[1] as f64,
-                        b: bg[2] as f64,
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timer.render("terrain"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = self.target.begin_pass(enc, "terrain", s.background, timer);
         pass.set_pipeline(&self.render_pipeline);
         pass.set_bind_group(0, &self.render_groups[0], &[]);
         pass.set_bind_group(1, &self.render_groups[1], &[]);
@@ -429,20 +393,8 @@ impl TerrainRenderer {
         pass.draw_indexed(0..self.index_count, 0, 0..1);
     }
 
-    pub fn target_view(&self) -> &wgpu::TextureView {
-        &self.target_view
-    }
-
     pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
-        let (t, tv, dv) = super::mesh_renderer::targets(gpu, width.max(1), height.max(1));
-        (self.target, self.target_view, self.depth_view) = (t, tv, dv);
-        (self.width, self.height) = (width.max(1), height.max(1));
-    }
-
-    pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
-        let px = super::readback::read_texture_4bpp(gpu, &self.target)?;
-        image::RgbaImage::from_raw(self.width, self.height, px)
-            .ok_or_else(|| Error::Internal("readback size".into()))
+        self.target = RenderTarget::new(gpu, width, height);
     }
 
     /// The top-down orthographic view in which pixel (x, y) of a map-sized image sees the

@@ -145,8 +145,8 @@ impl Player {
     /// The render target of the last frame.
     pub fn target_view(&self) -> &wgpu::TextureView {
         match self {
-            Player::Mesh(m) => m.renderer.target_view(),
-            Player::Terrain(t) => t.renderer.target_view(),
+            Player::Mesh(m) => &m.renderer.target.view,
+            Player::Terrain(t) => &t.renderer.target.view,
         }
     }
 
@@ -162,8 +162,8 @@ impl Player {
     /// The last frame as an image.
     pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
         match self {
-            Player::Mesh(m) => m.renderer.read_image(gpu),
-            Player::Terrain(t) => t.renderer.read_image(gpu),
+            Player::Mesh(m) => m.renderer.target.read_image(gpu),
+            Player::Terrain(t) => t.renderer.target.read_image(gpu),
         }
     }
 }

@@ -77,7 +77,7 @@ impl TerrainPlayer {
     pub fn render(&mut self, gpu: &Gpu, camera: &Camera, timer: &mut PassTimer) -> Result<()> {
         timer.reset();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        let vp = camera.view_projection(self.renderer.width, self.renderer.height);
+        let vp = camera.view_projection(self.renderer.target.width, self.renderer.target.height);
         self.renderer
             .record(gpu, &mut enc, vp, camera.eye, &self.settings, timer);
         timer.resolve(&mut enc);
