@@ -5,7 +5,7 @@
 use crate::ui::Ui;
 use clap::{Args, Subcommand};
 use relume::error::exit;
-use relume::heightmap::{load_heightmap, HeightMap};
+use relume::heightmap::HeightMap;
 use relume::pipeline::{Input, Pipeline, Stage};
 use relume::radiosity::formfactor::{Estimator, FormFactorParams};
 use relume::radiosity::patches::Resolution;
@@ -185,34 +185,23 @@ fn scene_of(src: &SceneSource) -> Result<(Scene, String, Option<Pipeline>)> {
 }
 
 fn map_of(args: &TerrainArgs) -> Result<(HeightMap, String)> {
-    let (path, mut opts, name) = match (&args.heightmap, &args.pipeline) {
-        (Some(h), _) => (h.clone(), Default::default(), h.display().to_string()),
+    // The same loading (pipeline knobs, overrides) as `shadow` and `softshadow`.
+    let (input, name) = match (&args.heightmap, &args.pipeline) {
+        (Some(h), _) => (h.clone(), h.display().to_string()),
         (None, p) => {
             let p = match p {
                 Some(p) => p.clone(),
                 None => bundled("pipelines/puget-sound.ron")?,
             };
-            let pipeline = relume::pipeline::parse_pipeline(&p)?;
-            let Input::HeightMap(h) = &pipeline.input else {
-                return Err(Error::input(
-                    &p,
-                    "this pipeline's input is a scene; the terrain study needs a height map",
-                ));
-            };
-            (
-                h.path.clone(),
-                h.options(),
-                format!("the height map of {}", p.display()),
-            )
+            let name = format!("the height map of {}", p.display());
+            (p, name)
         }
     };
-    if let Some(c) = args.cell_size {
-        opts.cell_size = Some([c, c]);
-    }
-    if let Some(s) = args.height_scale {
-        opts.height_scale = Some(s);
-    }
-    let (map, _) = load_heightmap(&path, &opts)?;
+    let map = crate::terrain::load_map(&crate::terrain::MapArgs {
+        input,
+        cell_size: args.cell_size,
+        height_scale: args.height_scale,
+    })?;
     let name = format!(
         "{name}: {}x{}, cell {} x {} m",
         map.width, map.height, map.cell_size[0], map.cell_size[1]

@@ -68,7 +68,14 @@ pub struct ShadowArgs {
     /// Shadow mask to write (.png: white = lit, black = shadow)
     #[arg(long, value_name = "MASK.png")]
     pub out: PathBuf,
-    /// Also write a shaded relief (.png, sRGB): Lambert × k_shadow inside shadows
+    #[command(flatten)]
+    pub relief: ReliefArgs,
+}
+
+/// The optional shaded relief of `shadow` and `softshadow`.
+#[derive(Args)]
+pub struct ReliefArgs {
+    /// Also write a shaded relief (.png, sRGB): Lambert × (k_shadow + (1 − k_shadow)·lit)
     #[arg(long, value_name = "RELIEF.png")]
     pub shaded: Option<PathBuf>,
     /// Shadow brightness with the sun on the horizon
@@ -77,6 +84,31 @@ pub struct ShadowArgs {
     /// Shadow brightness with the sun at the zenith
     #[arg(long, default_value_t = 0.6, value_name = "K")]
     pub k_bright: f64,
+}
+
+impl ReliefArgs {
+    /// Check the knobs before any work.
+    fn check(&self) -> Result<()> {
+        relief::check_k(self.k_dark, self.k_bright)?;
+        match &self.shaded {
+            Some(s) => check_extension(s, &["png"]),
+            None => Ok(()),
+        }
+    }
+
+    /// Write the relief when asked for; `shadow` is the shadowed fraction per texel.
+    fn write(&self, map: &HeightMap, sun: &Sun, shadow: &[f32]) -> Result<()> {
+        if let Some(path) = &self.shaded {
+            let relief = relief::shaded_relief(map, sun, shadow, self.k_dark, self.k_bright);
+            let px = relief.into_iter().map(images::linear_to_srgb8).collect();
+            images::write_png_gray8(path, map.width, map.height, px)?;
+        }
+        Ok(())
+    }
+
+    fn json(&self) -> Option<String> {
+        self.shaded.as_ref().map(|p| p.display().to_string())
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -152,25 +184,15 @@ pub struct SoftShadowArgs {
     /// Lit fraction to write: .png (16-bit, 65535 = fully lit) or .exr (f32)
     #[arg(long, value_name = "LIT.png|LIT.exr")]
     pub out: PathBuf,
-    /// Also write a shaded relief (.png, sRGB): Lambert × (k_shadow + (1 − k_shadow)·lit)
-    #[arg(long, value_name = "RELIEF.png")]
-    pub shaded: Option<PathBuf>,
-    /// Shadow brightness with the sun on the horizon
-    #[arg(long, default_value_t = 0.2, value_name = "K")]
-    pub k_dark: f64,
-    /// Shadow brightness with the sun at the zenith
-    #[arg(long, default_value_t = 0.6, value_name = "K")]
-    pub k_bright: f64,
+    #[command(flatten)]
+    pub relief: ReliefArgs,
 }
 
 /// `relume-bake softshadow`.
 pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
     let sun = Sun::new(args.sun.sun_azimuth, args.sun.sun_elevation)?;
-    relief::check_k(args.k_dark, args.k_bright)?;
     check_extension(&args.out, &["png", "exr"])?;
-    if let Some(s) = &args.shaded {
-        check_extension(s, &["png"])?;
-    }
+    args.relief.check()?;
     let method = match args.method {
         SoftMethodArg::Exhaustive => SoftMethod::Exhaustive,
         SoftMethodArg::Uniform => SoftMethod::Uniform { steps: args.steps },
@@ -201,11 +223,9 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
             .collect();
         images::write_png_gray16(&args.out, map.width, map.height, px)?;
     }
-    if let Some(path) = &args.shaded {
+    if args.relief.shaded.is_some() {
         let shadow: Vec<f32> = lit.iter().map(|l| 1.0 - l).collect();
-        let relief = relief::shaded_relief(&map, &sun, &shadow, args.k_dark, args.k_bright);
-        let px = relief.into_iter().map(images::linear_to_srgb8).collect();
-        images::write_png_gray8(path, map.width, map.height, px)?;
+        args.relief.write(&map, &sun, &shadow)?;
     }
     let n = lit.len() as f64;
     let mean = lit.iter().map(|&l| l as f64).sum::<f64>() / n;
@@ -222,7 +242,7 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
             "mean_lit": mean, "penumbra_fraction": penumbra,
             "seconds": seconds, "mpixels_per_second": mpix,
             "out": args.out.display().to_string(),
-            "shaded": args.shaded.as_ref().map(|p| p.display().to_string()),
+            "shaded": args.relief.json(),
         }));
     } else if !quiet {
         eprintln!(
@@ -278,11 +298,8 @@ fn print_json(v: &serde_json::Value) {
 /// `relume-bake shadow`.
 pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
     let sun = Sun::new(args.sun.sun_azimuth, args.sun.sun_elevation)?;
-    relief::check_k(args.k_dark, args.k_bright)?;
     check_extension(&args.out, &["png"])?;
-    if let Some(s) = &args.shaded {
-        check_extension(s, &["png"])?;
-    }
+    args.relief.check()?;
     ui.begin("load", 0);
     let map = load_map(&args.map)?;
     ui.finish();
@@ -296,11 +313,9 @@ pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32
     let shadowed = mask.iter().filter(|s| **s).count();
     let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
     images::write_png_gray8(&args.out, map.width, map.height, pixels)?;
-    if let Some(path) = &args.shaded {
+    if args.relief.shaded.is_some() {
         let shadow: Vec<f32> = mask.iter().map(|&s| s as u8 as f32).collect();
-        let relief = relief::shaded_relief(&map, &sun, &shadow, args.k_dark, args.k_bright);
-        let px = relief.into_iter().map(images::linear_to_srgb8).collect();
-        images::write_png_gray8(path, map.width, map.height, px)?;
+        args.relief.write(&map, &sun, &shadow)?;
     }
     let fraction = shadowed as f64 / mask.len() as f64;
     let mpix = mask.len() as f64 / seconds.max(1e-9) / 1e6;
@@ -314,7 +329,7 @@ pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32
             "shadowed_fraction": fraction,
             "seconds": seconds, "mpixels_per_second": mpix,
             "out": args.out.display().to_string(),
-            "shaded": args.shaded.as_ref().map(|p| p.display().to_string()),
+            "shaded": args.relief.json(),
         }));
     } else if !quiet {
         eprintln!(
