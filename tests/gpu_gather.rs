@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bake, data, expect_code};
+use common::{bake, data, expect_code, gpu};
 use relume::compress::stages::read_encoded;
 use relume::compress::{
     compress, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderOptions,
@@ -12,16 +12,6 @@ use relume::compress::{
 };
 use relume::gpu::compressed_gather::{CompressedGather, DecodePath};
 use relume::gpu::{compute, readback, timing::PassTimer, Gpu};
-
-fn gpu() -> Option<Gpu> {
-    match Gpu::new(None) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            eprintln!("SKIP: {e}");
-            None
-        }
-    }
-}
 
 /// A deterministic, uneven light: E per channel in [0, 1), some patches dark.
 fn light(n: usize) -> Vec<[f32; 3]> {

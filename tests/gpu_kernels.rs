@@ -3,19 +3,11 @@
 
 mod common;
 
-use relume::gpu::{compute, readback, shader_source, Gpu, SHADERS};
+use common::gpu;
+
+use relume::gpu::{compute, readback, shader_source, SHADERS};
 
 /// The GPU, or None with a visible message when no adapter exists at all.
-fn gpu() -> Option<Gpu> {
-    match Gpu::new(None) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            eprintln!("SKIP: {e}");
-            None
-        }
-    }
-}
-
 #[test]
 fn every_wgsl_file_validates_with_naga() {
     // Every file in shaders/ must be registered (embedded) and valid with common.wgsl prepended.

@@ -3,25 +3,15 @@
 
 mod common;
 
-use common::{bake, data, expect_code};
+use common::{bake, data, expect_code, gpu};
 use glam::Vec3;
-use relume::gpu::{readback, Gpu};
+use relume::gpu::readback;
 use relume::player::{Player, PlayerOptions, Sun, TransportChoice};
 use relume::radiosity::PatchSet;
 use relume::render::direct::{corner_indirect, gather_dense, patch_exitance};
 use relume::render::mesh_reference::FrameSettings;
 use relume::render::raycast::RaycastScene;
 use std::path::Path;
-
-fn gpu() -> Option<Gpu> {
-    match Gpu::new(None) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            eprintln!("SKIP: {e}");
-            None
-        }
-    }
-}
 
 fn bake_pipeline(dir: &Path, pipeline: &str) -> std::path::PathBuf {
     let out = dir.join("bake");

@@ -5,6 +5,8 @@
 
 mod common;
 
+use common::gpu;
+
 use relume::gpu::terrain_renderer::TerrainRenderer;
 use relume::gpu::{timing::PassTimer, Gpu};
 use relume::heightmap::{load_heightmap, HeightMap, HeightMapOptions};
@@ -13,16 +15,6 @@ use relume::terrain::hard_f32::{shadowed_accelerated_f32, shadowed_exact_f32, Tr
 use relume::terrain::relief::{shadow_mask, HardMethod};
 use relume::terrain::sun::{Sun, Track};
 use relume::terrain::MinMaxMipmap;
-
-fn gpu() -> Option<Gpu> {
-    match Gpu::new(None) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            eprintln!("SKIP: {e}");
-            None
-        }
-    }
-}
 
 fn srtm_half() -> HeightMap {
     let (m, _) = load_heightmap(

@@ -88,3 +88,15 @@ pub fn list_files(dir: &Path) -> Vec<String> {
     out.sort();
     out
 }
+
+/// The GPU (Mesa lavapipe in CI), or None with a visible SKIP message when there is no adapter
+/// at all.
+pub fn gpu() -> Option<relume::gpu::Gpu> {
+    match relume::gpu::Gpu::new(None) {
+        Ok(g) => Some(g),
+        Err(e) => {
+            eprintln!("SKIP: {e}");
+            None
+        }
+    }
+}
