@@ -81,7 +81,7 @@ fn main() {
                 let mut passes: BTreeMap<String, Vec<f64>> = BTreeMap::new();
                 for f in 0..=frames {
                     let sun = Sun {
-                        azimuth_deg: 300.0 + 10.0 * f as f32,
+                        azimuth_deg: 300.0 + 10.0 * f as f64,
                         elevation_deg: 12.0,
                     };
                     let t0 = Instant::now();

@@ -6,7 +6,7 @@
 
 use relume::progress::Silent;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
-use relume::radiosity::patches::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::transport::{products, transport, Bounces, Power, TransportParams};
 use std::time::Instant;
 

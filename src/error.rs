@@ -28,6 +28,19 @@ pub mod exit {
     pub const UNSUPPORTED: i32 = 6;
     /// A baked directory failed verification (`inspect`: a missing, truncated or altered file).
     pub const VERIFY: i32 = 7;
+
+    /// The table every binary prints in its help (`after_help`).
+    pub const HELP: &str = "\
+Exit codes:
+  0  success
+  1  internal error (a bug in relume: please report it)
+  2  usage error (bad command line)
+  3  invalid input (malformed file, NaN height, out-of-range knob)
+  4  I/O error (cannot read or write a file)
+  5  over a resource limit (e.g. --max-memory)
+  6  unsupported (valid input that this version cannot handle; relume-player: no GPU adapter,
+     install mesa-vulkan-drivers)
+  7  verification failed (a missing, truncated or altered file of a bake)";
 }
 
 /// Everything that can go wrong, sorted by who is at fault.

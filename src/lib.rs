@@ -21,6 +21,5 @@ pub mod render;
 pub mod scene;
 pub mod study;
 pub mod terrain;
-pub mod workspace;
 
 pub use error::{Error, Result};

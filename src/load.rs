@@ -134,3 +134,92 @@ pub fn load_any(
         Ok(LoadedInput::HeightMap(m, i))
     }
 }
+
+impl SceneSummary {
+    /// The summary as text for people (`relume-bake load`).
+    pub fn to_text(&self) -> String {
+        let mut t = format!(
+            "scene      {}\ntriangles  {} ({} degenerate), vertices {}\nobjects    {}\nmaterials  {}\n",
+            self.path,
+            self.triangles,
+            self.degenerate_triangles,
+            self.vertices,
+            self.objects.join(", "),
+            self.materials.len()
+        );
+        for m in &self.materials {
+            t += &format!(
+                "  {:<16} albedo {:?}  emission {:?}\n",
+                m.name, m.albedo, m.emission
+            );
+        }
+        t += &format!("lights     {}\n", self.lights.len());
+        for l in &self.lights {
+            t += &format!(
+                "  {:<16} {:?} intensity {} colour {:?}\n",
+                l.name, l.kind, l.intensity, l.color
+            );
+        }
+        t += &format!(
+            "bounds     {:?} .. {:?}\narea       {:.6}\ngrey       {}\n",
+            self.bounds_min, self.bounds_max, self.total_area, self.grey
+        );
+        t
+    }
+}
+
+impl HeightMapSummary {
+    /// The summary as text for people (`relume-bake load`).
+    pub fn to_text(&self) -> String {
+        format!(
+            "height map {} ({} {})\nsize       {} x {}\ncell size  {} x {} m ({})\nheights    {} .. {} m (height scale {})\nno-data    {}\n",
+            self.path,
+            self.format,
+            self.sample,
+            self.width,
+            self.height,
+            self.cell_size[0],
+            self.cell_size[1],
+            self.cell_size_source,
+            self.min,
+            self.max,
+            self.height_scale,
+            self.nodata_count
+        )
+    }
+}
+
+/// The height map of a terrain command: a height-map file, or the height-map input of a pipeline
+/// file (`.ron`) with its knobs; `cell_size` and `height_scale` override both.
+pub fn heightmap_input(
+    input: &Path,
+    cell_size: Option<f64>,
+    height_scale: Option<f64>,
+) -> Result<HeightMap> {
+    let is_pipeline = input
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+    let (path, mut opts) = if is_pipeline {
+        let p = crate::pipeline::parse_pipeline(input)?;
+        match &p.input {
+            Input::HeightMap(h) => (h.path.clone(), h.options()),
+            Input::Scene(_) => {
+                return Err(Error::input(
+                    input,
+                    "this pipeline's input is a scene; terrain commands need a height map",
+                ))
+            }
+        }
+    } else {
+        (input.to_path_buf(), HeightMapOptions::default())
+    };
+    if let Some(c) = cell_size {
+        opts.cell_size = Some([c, c]);
+    }
+    if let Some(s) = height_scale {
+        opts.height_scale = Some(s);
+    }
+    let (map, _) = load_heightmap(&path, &opts)?;
+    Ok(map)
+}

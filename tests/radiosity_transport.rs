@@ -5,7 +5,7 @@ use proptest::prelude::*;
 use relume::progress::Silent;
 use relume::radiosity::fixtures;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
-use relume::radiosity::patches::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::reference::gauss_seidel;
 use relume::radiosity::transport::{transport, Bounces, Power, Transport, TransportParams};
 use relume::scene::Scene;

@@ -182,3 +182,77 @@ pub fn verify(dir: &Path, manifest: &Manifest) -> Vec<VerifyProblem> {
     }
     problems
 }
+
+/// A baked directory read and verified (`relume-bake inspect`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Inspection {
+    pub dir: String,
+    pub ok: bool,
+    pub manifest: Manifest,
+    pub problems: Vec<VerifyProblem>,
+}
+
+impl Inspection {
+    /// Read the manifest of `dir` and verify every file it lists.
+    pub fn of(dir: &Path) -> Result<Inspection> {
+        let manifest = Manifest::read(dir)?;
+        let problems = verify(dir, &manifest);
+        Ok(Inspection {
+            dir: dir.display().to_string(),
+            ok: problems.is_empty(),
+            manifest,
+            problems,
+        })
+    }
+
+    /// The first problem as an error (exit code 7), or `Ok` when the bake is intact.
+    pub fn result(&self) -> Result<()> {
+        match self.problems.first() {
+            None => Ok(()),
+            Some(first) => Err(crate::error::Error::verify(
+                Path::new(&self.dir).join(&first.file),
+                format!(
+                    "{} ({} problem(s) in this bake)",
+                    first.problem,
+                    self.problems.len()
+                ),
+            )),
+        }
+    }
+
+    /// The manifest and the state of every file, for people.
+    pub fn to_text(&self) -> String {
+        let m = &self.manifest;
+        let mut t = format!(
+            "baked dir  {}\nformat     v{} (relume {})\ninput      {} ({} bytes, sha256 {})\n",
+            self.dir,
+            m.format_version,
+            m.relume_version,
+            m.input.name,
+            m.input.bytes,
+            &m.input.sha256[..16.min(m.input.sha256.len())]
+        );
+        for s in &m.stages {
+            t += &format!("stage      {}  → {}\n", s.stage, s.outputs.join(", "));
+            for (k, v) in &s.report {
+                t += &format!("  {k:<28} {v}\n");
+            }
+            for (k, v) in &s.facts {
+                t += &format!("  {k:<28} {v}\n");
+            }
+        }
+        for f in &m.files {
+            let status = self
+                .problems
+                .iter()
+                .find(|p| p.file == f.name)
+                .map(|p| p.problem.as_str())
+                .unwrap_or("ok");
+            t += &format!(
+                "file       {:<28} {:>12} bytes  {}\n",
+                f.name, f.bytes, status
+            );
+        }
+        t
+    }
+}

@@ -143,8 +143,8 @@ fn floats(s: &str) -> std::result::Result<Vec<f32>, String> {
 fn parse_sun(s: &str) -> std::result::Result<Sun, String> {
     match floats(s)?.as_slice() {
         [az, el] if (-90.0..=90.0).contains(el) => Ok(Sun {
-            azimuth_deg: *az,
-            elevation_deg: *el,
+            azimuth_deg: *az as f64,
+            elevation_deg: *el as f64,
         }),
         [_, el] => Err(format!("elevation {el} is outside -90..=90 degrees")),
         _ => Err(format!("`{s}` is not AZIMUTH,ELEVATION (e.g. 135,30)")),
@@ -263,7 +263,7 @@ fn run(cli: &Cli) -> Result<()> {
     let mut frames = Vec::new();
     for f in 0..cli.frames {
         let sun = cli.sun.map(|s| Sun {
-            azimuth_deg: s.azimuth_deg + 360.0 * f as f32 / cli.frames as f32,
+            azimuth_deg: s.azimuth_deg + 360.0 * f as f64 / cli.frames as f64,
             ..s
         });
         let t0 = Instant::now();

@@ -15,10 +15,27 @@
 //! of the padded matrix.
 
 use super::dense::{DenseEncoding, DenseTexture};
-use crate::error::{Error, IoContext, Result};
+use crate::error::{Error, Result};
 use ddsfile::{AlphaMode, D3D10ResourceDimension, D3DFormat, Dds, DxgiFormat};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// A texture container the `encode` stage writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+pub enum Container {
+    Dds,
+    Ktx2,
+}
+
+impl Container {
+    /// The file extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Container::Dds => "dds",
+            Container::Ktx2 => "ktx2",
+        }
+    }
+}
 
 /// A rectangle of the padded texture stored in one file.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -189,9 +206,8 @@ pub fn dds_bytes(
     Ok(out)
 }
 
-/// Read a DDS tile: (width, height, layers).
-pub fn read_dds(path: &Path, enc: DenseEncoding) -> Result<(u32, u32, Vec<Vec<u8>>)> {
-    let bytes = std::fs::read(path).at(path, "cannot read")?;
+/// Parse a DDS tile: (width, height, layers). `path` names the file in errors.
+pub fn parse_dds(path: &Path, bytes: &[u8], enc: DenseEncoding) -> Result<(u32, u32, Vec<Vec<u8>>)> {
     let dds =
         Dds::read(&bytes[..]).map_err(|e| Error::input(path, format!("not a DDS file: {e}")))?;
     let ok = match enc {
@@ -303,13 +319,14 @@ pub fn ktx2_bytes(enc: DenseEncoding, width: u32, height: u32, layers: &[Vec<u8>
     out
 }
 
-/// Read a KTX2 tile written by [`ktx2_bytes`]: (width, height, layers).
-pub fn read_ktx2(
+/// Parse a KTX2 tile written by [`ktx2_bytes`]: (width, height, layers). `path` names the
+/// file in errors.
+pub fn parse_ktx2(
     path: &Path,
+    bytes: &[u8],
     enc: DenseEncoding,
     layer_count: usize,
 ) -> Result<(u32, u32, Vec<Vec<u8>>)> {
-    let bytes = std::fs::read(path).at(path, "cannot read")?;
     let bad = |m: String| Error::input(path, format!("not a relume KTX2 texture: {m}"));
     if bytes.len() < 104 || bytes[..12] != KTX2_MAGIC {
         return Err(bad("missing KTX2 identifier".into()));

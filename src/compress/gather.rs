@@ -8,7 +8,8 @@
 //! two vectors. The summation order is fixed, so the result does not depend on the thread count.
 
 use super::dense::BlockValues;
-use super::{permute_vector, unpermute_vector, EncodedTransport};
+use super::EncodedTransport;
+use crate::radiosity::matrix::{permute_vector, unpermute_vector};
 use rayon::prelude::*;
 
 /// `B = S · E` per channel from `enc`; `e` and the result are `[channels][n]` in original

@@ -14,12 +14,12 @@
 //! large entries that the split removes anyway.
 
 use super::logmap::LogMap;
-use super::TransportMatrix;
+use crate::radiosity::TransportMatrix;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// What the greedy pass compares.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum)]
 pub enum ReorderMetric {
     /// The seed's: sum of absolute differences of the raw values.
     #[default]

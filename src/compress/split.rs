@@ -6,8 +6,8 @@
 //! index `i·n + j`, so the selection is deterministic. The sidecar is CSR over rows of the
 //! (permuted) matrix; its binary layout is in docs/baked-format.md (`sidecar.bin`).
 
-use super::TransportMatrix;
-use crate::error::{Error, IoContext, Result};
+use crate::radiosity::TransportMatrix;
+use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -133,17 +133,6 @@ impl Sidecar {
             cols,
             values,
         })
-    }
-
-    /// Write `sidecar.bin`.
-    pub fn write(&self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.to_bytes()).at(path, "cannot write")
-    }
-
-    /// Read `sidecar.bin`.
-    pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).at(path, "cannot read")?;
-        Self::from_bytes(path, &bytes)
     }
 }
 

@@ -246,7 +246,7 @@ fn bc6h_to_f16_layers(t: &EncodedTransport) -> Vec<Vec<u8>> {
     for by in 0..bw {
         for bx in 0..bw {
             let k = (by * bw + bx) * 16;
-            let texels = crate::compress::blocks::bc6h_decode_block(&tex.layers[0][k..k + 16]);
+            let texels = crate::compress::bc6h::bc6h_decode_block(&tex.layers[0][k..k + 16]);
             for (ti, texel) in texels.iter().enumerate() {
                 let (x, y) = (4 * bx + ti % 4, 4 * by + ti / 4);
                 for (c, layer) in layers.iter_mut().enumerate() {

@@ -168,7 +168,7 @@ macro_rules! shaders {
 pub const SHADERS: &[(&str, &str)] = shaders![
     "blit.wgsl",
     "common.wgsl",
-    "corner_transfer.wgsl",
+    "corner_interpolate.wgsl",
     "direct_light.wgsl",
     "gather_compressed.wgsl",
     "gather_dense.wgsl",

@@ -1,6 +1,6 @@
 //! The per-frame radiosity passes on the GPU: direct exitance per patch
 //! (`direct_light.wgsl`), the gather B = S·E (`gather_dense.wgsl` for the f32 reference
-//! encoding), and the transfer to the mesh's triangle corners (`corner_transfer.wgsl`), which
+//! encoding), and the transfer to the mesh's triangle corners (`corner_interpolate.wgsl`), which
 //! writes the mesh renderer's per-corner `indirect` vertex buffer.
 
 use super::compressed_gather::{CompressedGather, DecodePath};
@@ -9,20 +9,13 @@ use super::mesh_renderer::MeshRenderer;
 use super::timing::PassTimer;
 use super::Gpu;
 use crate::error::{Error, Result};
-use crate::radiosity::PatchSet;
+use crate::radiosity::{PatchSet, TransportMatrix};
 use crate::render::mesh_reference::FrameSettings;
-
-/// A dense `[channels, n, n]` f32 transport matrix.
-pub struct DenseTransport<'a> {
-    pub channels: usize,
-    pub n: usize,
-    pub data: &'a [f32],
-}
 
 /// Where the runtime's transport comes from.
 pub enum TransportSource<'a> {
     /// The uncompressed `transport.npy` (the reference encoding).
-    Dense(DenseTransport<'a>),
+    Dense(&'a TransportMatrix),
     /// The `encode` stage's output, decoded by the given path.
     Compressed(&'a crate::compress::EncodedTransport, DecodePath),
 }
@@ -189,13 +182,13 @@ impl RadiosityRuntime {
         });
 
         let gather = match transport {
-            TransportSource::Dense(d) => dense_gather(gpu, &d, &exitance, &indirect)?,
+            TransportSource::Dense(d) => dense_gather(gpu, d, &exitance, &indirect)?,
             TransportSource::Compressed(t, path) => {
                 Gather::Compressed(CompressedGather::new(gpu, t, path, &exitance, &indirect)?)
             }
         };
 
-        let transfer = compute::pipeline(gpu, "corner_transfer.wgsl", "main")?;
+        let transfer = compute::pipeline(gpu, "corner_interpolate.wgsl", "main")?;
         let corners = renderer.corners();
         let tparams = compute::uniform(gpu, "transfer params", &[corners, 0, 0, 0]);
         let offsets = compute::storage(gpu, "transfer offsets", &set.corners.offsets);
@@ -285,7 +278,7 @@ fn groups_for(count: u32) -> u32 {
 /// The dense f32 gather: one bind group per colour channel.
 fn dense_gather(
     gpu: &Gpu,
-    d: &DenseTransport<'_>,
+    d: &TransportMatrix,
     exitance: &wgpu::Buffer,
     indirect: &wgpu::Buffer,
 ) -> Result<Gather> {

@@ -13,13 +13,13 @@
 //! Input paths are relative to the pipeline file; the output directory is relative to the
 //! current directory (and `--out` overrides it).
 
+pub mod checks;
+pub mod knobs;
 pub mod parse;
-pub mod plan;
 mod stage;
 
 pub use parse::{parse_pipeline, PLANNED_STAGES};
-pub use plan::{plan, Plan, PlanState, PlannedStage};
-pub use stage::{Stage, StageKind, StageRun};
+pub use stage::{Stage, StageKind};
 
 use crate::heightmap::{HeightMapOptions, NoDataPolicy};
 use crate::scene::SceneOptions;
@@ -57,13 +57,13 @@ pub struct SceneInput {
     /// Path of the scene file, relative to the pipeline file.
     pub path: PathBuf,
     /// Factor applied to all positions (0.001 turns millimetres into metres). Default 1.
-    #[serde(default = "one", deserialize_with = "parse::positive_f32")]
+    #[serde(default = "one", deserialize_with = "checks::de::positive_f32")]
     pub scale: f32,
     /// Punctual lights added to the scene's own, in world units (after `scale`); the player
     /// lights the scene with them every frame (the baked transport does not depend on them).
     #[serde(
         default,
-        deserialize_with = "parse::lights",
+        deserialize_with = "checks::de::lights",
         skip_serializing_if = "Vec::is_empty"
     )]
     pub lights: Vec<crate::scene::punctual::LightSpec>,
@@ -78,14 +78,14 @@ pub struct HeightMapInput {
     /// Metres per texel (x, y); default: the GeoTIFF world file or pixel-scale tag, else 1 m.
     #[serde(
         default,
-        deserialize_with = "parse::optional_cell_size",
+        deserialize_with = "checks::de::optional_cell_size",
         skip_serializing_if = "Option::is_none"
     )]
     pub cell_size: Option<(f64, f64)>,
     /// Metres per file unit (default 1).
     #[serde(
         default,
-        deserialize_with = "parse::optional_positive_f64",
+        deserialize_with = "checks::de::optional_positive_f64",
         skip_serializing_if = "Option::is_none"
     )]
     pub height_scale: Option<f64>,
@@ -102,7 +102,7 @@ pub struct HeightMapInput {
     /// cell size grows by the same factor. Default 1.
     #[serde(
         default = "one_u32",
-        deserialize_with = "parse::at_least_one",
+        deserialize_with = "checks::de::at_least_one",
         skip_serializing_if = "is_one"
     )]
     pub downsample: u32,
@@ -118,6 +118,22 @@ fn is_one(v: &u32) -> bool {
 
 fn one() -> f32 {
     1.0
+}
+
+/// Where a bake of the pipeline at `pipeline_path` goes: `out` (the `--out` flag), else the
+/// pipeline's `output`, else `out/<pipeline file stem>`.
+pub fn output_dir(pipeline_path: &Path, p: &Pipeline, out: Option<&Path>) -> PathBuf {
+    if let Some(o) = out {
+        return o.to_path_buf();
+    }
+    if let Some(o) = &p.output {
+        return o.clone();
+    }
+    let stem = pipeline_path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "bake".into());
+    PathBuf::from("out").join(stem)
 }
 
 impl SceneInput {

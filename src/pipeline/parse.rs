@@ -5,7 +5,6 @@
 use super::Pipeline;
 use crate::error::{Error, IoContext, Result};
 use ron::extensions::Extensions;
-use serde::{Deserialize, Deserializer};
 use std::path::Path;
 
 /// Stage names that belong to relume's design but are not implemented by this version. A
@@ -164,94 +163,6 @@ fn closest<'a>(found: &str, expected: &[&'a str]) -> Option<&'a str> {
         .filter(|(d, _)| *d <= 2.max(found.len() / 3))
         .min()
         .map(|(_, e)| e)
-}
-
-// ---- validated knob deserialisers (errors carry the knob's position) ----
-
-fn check<'de, D: Deserializer<'de>, T>(
-    v: T,
-    ok: bool,
-    what: impl FnOnce(&T) -> String,
-) -> Result<T, D::Error> {
-    if ok {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(what(&v)))
-    }
-}
-
-/// Punctual lights, each checked by [`crate::scene::punctual::LightSpec::to_light`].
-pub fn lights<'de, D: Deserializer<'de>>(
-    d: D,
-) -> Result<Vec<crate::scene::punctual::LightSpec>, D::Error> {
-    let v = Vec::<crate::scene::punctual::LightSpec>::deserialize(d)?;
-    for (k, l) in v.iter().enumerate() {
-        if let Err(e) = l.to_light("") {
-            return Err(serde::de::Error::custom(format!("light {k}: {e}")));
-        }
-    }
-    Ok(v)
-}
-
-/// A finite f32 greater than zero.
-pub fn positive_f32<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
-    let v = f32::deserialize(d)?;
-    check::<D, _>(v, v.is_finite() && v > 0.0, |v| {
-        format!("out of range: {v} (must be a positive finite number)")
-    })
-}
-
-/// An optional finite f64 greater than zero.
-pub fn optional_positive_f64<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
-    let v = Option::<f64>::deserialize(d)?;
-    let ok = v.is_none_or(|x| x.is_finite() && x > 0.0);
-    check::<D, _>(v, ok, |v| {
-        format!(
-            "out of range: {:?} (must be a positive finite number)",
-            v.unwrap_or(0.0)
-        )
-    })
-}
-
-/// An optional (x, y) pair of positive finite f64.
-pub fn optional_cell_size<'de, D: Deserializer<'de>>(d: D) -> Result<Option<(f64, f64)>, D::Error> {
-    let v = Option::<(f64, f64)>::deserialize(d)?;
-    let ok = v.is_none_or(|(x, y)| x.is_finite() && y.is_finite() && x > 0.0 && y > 0.0);
-    check::<D, _>(v, ok, |v| {
-        format!("out of range: cell size {v:?} (both must be positive finite numbers)")
-    })
-}
-
-/// A count of at least 1.
-pub fn at_least_one<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    let v = u32::deserialize(d)?;
-    check::<D, _>(v, v >= 1, |v| {
-        format!("out of range: {v} (must be at least 1)")
-    })
-}
-
-/// A percentage in [0, 100].
-pub fn percent<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = f64::deserialize(d)?;
-    check::<D, _>(v, (0.0..=100.0).contains(&v), |v| {
-        format!("out of range: {v} (a percentage in [0, 100])")
-    })
-}
-
-/// Reorder passes: 0, 1 or 2.
-pub fn zero_to_two<'de, D: Deserializer<'de>>(d: D) -> Result<u8, D::Error> {
-    let v = u8::deserialize(d)?;
-    check::<D, _>(v, v <= 2, |v| {
-        format!("out of range: {v} (reorder passes are 0, 1 or 2)")
-    })
-}
-
-/// A texture side: a multiple of 4, at least 4.
-pub fn texture_size<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
-    let v = u32::deserialize(d)?;
-    check::<D, _>(v, v >= 4 && v % 4 == 0, |v| {
-        format!("out of range: {v} (a texture size is a positive multiple of 4)")
-    })
 }
 
 #[cfg(test)]

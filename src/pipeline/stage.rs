@@ -1,44 +1,29 @@
-//! The stages a pipeline can list, with their knobs, and the rules of their order.
+//! The stages a pipeline can list, with their knobs ([`super::knobs`]), and the rules of their
+//! order. How a stage runs lives in `crate::bake::stages`.
 
-use super::plan::{PlanState, PlannedStage};
+use super::knobs::{
+    EncodeKnobs, FormFactorsKnobs, MinmaxMipmapKnobs, ReorderKnobs, TransportKnobs, VoxelizeKnobs,
+};
 use super::Pipeline;
-use crate::baked::{BakeTransaction, StageRecord};
 use crate::error::{Error, Result};
-use crate::progress::Progress;
-use crate::workspace::Workspace;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// What every stage's knob struct implements: run over a [`Workspace`], and estimate its cost.
-pub trait StageRun {
-    /// Run the stage: take inputs from `ws`, write files into `txn`, leave artifacts in `ws` for
-    /// later stages, and return the record (outputs and deterministic measurements).
-    fn run(
-        &self,
-        ws: &mut Workspace,
-        txn: &mut BakeTransaction,
-        progress: &dyn Progress,
-    ) -> Result<StageRecord>;
-
-    /// Estimate peak memory and output bytes, updating `state` for later stages.
-    fn estimate(&self, state: &mut PlanState) -> PlannedStage;
-}
-
-/// One stage of a pipeline with its knobs. Each variant's knobs live beside the stage's code.
+/// One stage of a pipeline with its knobs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Stage {
-    /// Simplify the scene into voxel patches (`crate::radiosity::patches`).
-    Voxelize(crate::radiosity::stages::VoxelizeKnobs),
+    /// Simplify the scene into voxel patches (`crate::radiosity::voxelize`).
+    Voxelize(VoxelizeKnobs),
     /// Form factors between patches with BVH visibility (`crate::radiosity::formfactor`).
-    FormFactors(crate::radiosity::stages::FormFactorsKnobs),
+    FormFactors(FormFactorsKnobs),
     /// k-bounce or infinite-bounce transport matrix (`crate::radiosity::transport`).
-    Transport(crate::radiosity::stages::TransportKnobs),
+    Transport(TransportKnobs),
     /// Greedy reordering of the transport matrix (src/compress/reorder.rs).
-    Reorder(crate::compress::stages::ReorderKnobs),
+    Reorder(ReorderKnobs),
     /// Split, log map and block-compress the transport (src/compress/).
-    Encode(crate::compress::stages::EncodeKnobs),
+    Encode(EncodeKnobs),
     /// Min/max mipmap of a height map (`minmax_mipmap.exr`).
-    MinmaxMipmap(crate::terrain::mipmap_stage::MinmaxMipmapKnobs),
+    MinmaxMipmap(MinmaxMipmapKnobs),
 }
 
 /// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
@@ -63,18 +48,6 @@ impl Stage {
             Stage::Reorder(_) => StageKind::Reorder,
             Stage::Encode(_) => StageKind::Encode,
             Stage::MinmaxMipmap(_) => StageKind::MinmaxMipmap,
-        }
-    }
-
-    /// The stage's implementation.
-    pub fn runner(&self) -> &dyn StageRun {
-        match self {
-            Stage::Voxelize(k) => k,
-            Stage::FormFactors(k) => k,
-            Stage::Transport(k) => k,
-            Stage::Reorder(k) => k,
-            Stage::Encode(k) => k,
-            Stage::MinmaxMipmap(k) => k,
         }
     }
 }

@@ -3,14 +3,14 @@
 
 use super::Sun;
 use super::{PlayerOptions, TransportChoice};
-use crate::baked::{read_scene, Manifest};
+use crate::baked::{self, Manifest};
 use crate::error::Result;
 use crate::gpu::compressed_gather::DecodePath;
 use crate::gpu::mesh_renderer::MeshRenderer;
-use crate::gpu::radiosity_runtime::{DenseTransport, RadiosityRuntime, TransportSource};
+use crate::gpu::radiosity_runtime::{RadiosityRuntime, TransportSource};
 use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
-use crate::radiosity::{PatchSet, PATCHES_FILE, TRANSPORT_FILE};
+use crate::radiosity::PatchSet;
 use crate::render::camera::Camera;
 use crate::render::lights::GpuLight;
 use crate::render::mesh_reference::FrameSettings;
@@ -42,7 +42,7 @@ impl MeshPlayer {
         width: u32,
         height: u32,
     ) -> Result<Self> {
-        let scene = read_scene(dir)?;
+        let scene = baked::scene::read(dir)?;
         let renderer = MeshRenderer::new(gpu, &scene, width, height, SHADOW_SIZE)?;
         let scene_lights = scene
             .lights
@@ -139,14 +139,12 @@ fn load_radiosity(
     opts: &PlayerOptions,
     renderer: &MeshRenderer,
 ) -> Result<Option<(PatchSet, RadiosityRuntime)>> {
-    let has_encoded = manifest
-        .file(crate::compress::stages::TRANSFER_FILE)
-        .is_some();
-    let has_dense = manifest.file(TRANSPORT_FILE).is_some();
+    let has_encoded = manifest.file(baked::encoded::TRANSFER_FILE).is_some();
+    let has_dense = manifest.file(baked::transport::FILE).is_some();
     if !has_encoded && !has_dense {
         return Ok(None);
     }
-    let set: PatchSet = crate::baked::read_postcard(&dir.join(PATCHES_FILE))?;
+    let set = baked::patches::read(dir)?;
     let use_dense = match opts.transport {
         TransportChoice::Dense => true,
         TransportChoice::Compressed => false,
@@ -159,26 +157,8 @@ fn load_radiosity(
                 "this bake has no transport.npy (it was encoded only); drop --transport dense",
             ));
         }
-        let (shape, data) = crate::baked::read_npy_f32(&dir.join(TRANSPORT_FILE))?;
-        let (channels, n) = match shape.as_slice() {
-            [c, n, m] if n == m => (*c as usize, *n as usize),
-            _ => {
-                return Err(crate::error::Error::input(
-                    dir.join(TRANSPORT_FILE),
-                    format!("shape {shape:?} is not [channels, n, n]"),
-                ))
-            }
-        };
-        RadiosityRuntime::new(
-            gpu,
-            &set,
-            TransportSource::Dense(DenseTransport {
-                channels,
-                n,
-                data: &data,
-            }),
-            renderer,
-        )?
+        let matrix = baked::transport::read(dir)?;
+        RadiosityRuntime::new(gpu, &set, TransportSource::Dense(&matrix), renderer)?
     } else {
         if !has_encoded {
             return Err(crate::error::Error::input(
@@ -186,7 +166,7 @@ fn load_radiosity(
                 "this bake has no encoded transport (run the `encode` stage)",
             ));
         }
-        let encoded = crate::compress::stages::read_encoded(dir)?;
+        let encoded = baked::encoded::read(dir)?;
         let path = opts
             .decode
             .unwrap_or_else(|| DecodePath::best(gpu, encoded.dense.encoding));

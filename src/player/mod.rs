@@ -17,24 +17,9 @@ use crate::render::mesh_reference::FrameSettings;
 use serde::Serialize;
 use std::path::Path;
 
-/// The sun as azimuth (degrees clockwise from north) and elevation (degrees above the horizon).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Sun {
-    pub azimuth_deg: f32,
-    pub elevation_deg: f32,
-}
-
-impl Sun {
-    /// Unit vector toward the sun in a y-up scene whose north is −z:
-    /// (sin az · cos el, sin el, −cos az · cos el).
-    pub fn toward_y_up(&self) -> glam::Vec3 {
-        let (az, el) = (
-            self.azimuth_deg.to_radians(),
-            self.elevation_deg.to_radians(),
-        );
-        glam::Vec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos())
-    }
-}
+/// The one sun model (`crate::terrain::sun`), also the player's: azimuth in degrees clockwise
+/// from north, elevation above the horizon.
+pub use crate::terrain::sun::Sun;
 
 /// Which transport the runtime gathers from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]

@@ -2,8 +2,7 @@
 //! by the accelerated traversal, or soft by branch-and-bound) over the min/max mipmap, shadow
 //! brightness k_shadow, aerial perspective; the sun moves freely.
 
-use super::Sun as PlayerSun;
-use crate::baked::{read_heightmap, Manifest};
+use crate::baked::{self, Manifest};
 use crate::error::Result;
 use crate::gpu::terrain_renderer::TerrainRenderer;
 use crate::gpu::timing::PassTimer;
@@ -11,7 +10,6 @@ use crate::gpu::Gpu;
 use crate::heightmap::HeightMap;
 use crate::render::camera::Camera;
 use crate::render::terrain_shading::TerrainSettings;
-use crate::terrain::mipmap_stage::MIPMAP_FILE;
 use crate::terrain::sun::Sun;
 use crate::terrain::MinMaxMipmap;
 use std::path::Path;
@@ -33,9 +31,9 @@ impl TerrainPlayer {
         width: u32,
         height: u32,
     ) -> Result<Self> {
-        let map = read_heightmap(dir, manifest)?;
-        let mip = if manifest.file(MIPMAP_FILE).is_some() {
-            MinMaxMipmap::read_exr(&dir.join(MIPMAP_FILE))?
+        let map = baked::heightmap::read(dir, manifest)?;
+        let mip = if manifest.file(baked::mipmap::FILE).is_some() {
+            baked::mipmap::read(dir)?
         } else {
             MinMaxMipmap::build(&map)
         };
@@ -63,13 +61,13 @@ impl TerrainPlayer {
     }
 
     /// Set the sun (default: azimuth 300°, elevation 10°).
-    pub fn set_sun(&mut self, gpu: &Gpu, sun: Option<PlayerSun>) -> Result<()> {
-        let s = sun.unwrap_or(PlayerSun {
+    pub fn set_sun(&mut self, gpu: &Gpu, sun: Option<Sun>) -> Result<()> {
+        let s = sun.unwrap_or(Sun {
             azimuth_deg: 300.0,
             elevation_deg: 10.0,
         });
         self.renderer
-            .set_sun(gpu, Sun::new(s.azimuth_deg as f64, s.elevation_deg as f64)?);
+            .set_sun(gpu, Sun::new(s.azimuth_deg, s.elevation_deg)?);
         Ok(())
     }
 

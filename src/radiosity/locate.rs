@@ -5,7 +5,7 @@
 //! ceiling above the light) lies on the cover's piece, so it finds the cover's patch.
 
 use super::geometry::{self, dominant_axis};
-use super::patches::group_key;
+use super::geometry::group_key;
 use super::PatchSet;
 use crate::scene::Scene;
 use glam::DVec3;

@@ -1,5 +1,5 @@
 //! Radiosity bake, first half (DESIGN.md §3; seed 003 §3.5 and §4.1): the scene is simplified
-//! into patches ([`patches::voxelize`]), form factors between patches are estimated with BVH
+//! into patches ([`voxelize::voxelize`]), form factors between patches are estimated with BVH
 //! visibility ([`formfactor`]), and the k-bounce or infinite-bounce transport matrix
 //! `S = Σ_{h=1..k} (diag(ρ) F)^h` is precomputed ([`transport`]) so that the runtime gets the
 //! indirect light of any direct lighting `E` as one product `S · E` per colour channel.
@@ -9,30 +9,25 @@
 //! patch i that arrives at patch j, so the gathered irradiance is `H_i = Σ_j F_ij B_j` and
 //! `B = E + diag(ρ) F B`.
 //!
-//! Files of a bake: [`PATCHES_FILE`] (postcard [`PatchSet`]), [`FORM_FACTORS_FILE`] (`[n, n]`
-//! f32 .npy) and [`TRANSPORT_FILE`] (`[channels, n, n]` f32 .npy). docs/baked-format.md describes
+//! This module computes on plain data and writes no file: `crate::baked::{patches, form_factors,
+//! transport}` store its results, `crate::bake::stages::radiosity` runs it as pipeline stages.
+//! docs/baked-format.md describes
 //! them byte by byte.
 
 pub mod fixtures;
 pub mod formfactor;
 pub mod geometry;
 pub mod locate;
+pub mod matrix;
 pub mod overlap;
-pub mod patches;
+pub mod voxelize;
 pub mod reference;
-pub mod stages;
-pub mod transfer;
+pub mod corners;
 pub mod transport;
 pub mod visibility;
 
+pub use matrix::TransportMatrix;
 use serde::{Deserialize, Serialize};
-
-/// The patches of a scene bake (written by `voxelize`).
-pub const PATCHES_FILE: &str = "patches.bin";
-/// The form-factor matrix (written by `form_factors`).
-pub const FORM_FACTORS_FILE: &str = "form_factors.npy";
-/// The transport matrix (written by `transport`).
-pub const TRANSPORT_FILE: &str = "transport.npy";
 
 /// Everything `voxelize` produces: the patches, the pieces of triangles they are made of, points
 /// for the runtime's direct light, and the maps from the full mesh to the patches.

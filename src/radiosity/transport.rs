@@ -15,6 +15,7 @@
 //! clear message, a matrix whose spectral radius is (numerically) 1 or more — a closed scene with
 //! albedo 1 never loses energy — instead of returning huge or NaN entries.
 
+use super::TransportMatrix;
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::progress::Progress;
@@ -35,7 +36,7 @@ pub enum Bounces {
 }
 
 /// How `S_k` is evaluated for finite k.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 pub enum Power {
     /// Whichever of Horner and doubling needs fewer matrix products.
     #[default]
@@ -60,14 +61,11 @@ pub struct TransportParams {
     pub max_memory: u64,
 }
 
-/// The transport matrices of every modelled channel.
+/// The transport matrices of every modelled channel, with what computing them took.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transport {
-    /// 1 for grey scenes, else 3.
-    pub channels: usize,
-    pub n: usize,
-    /// `[channels, n, n]` row-major.
-    pub values: Vec<f32>,
+    /// `S` per channel (1 for grey scenes, else 3).
+    pub matrix: TransportMatrix,
     /// Bounces accumulated per channel (0 = infinite).
     pub bounces: Vec<u32>,
     /// Matrix products (GEMMs) performed, all channels.
@@ -75,23 +73,6 @@ pub struct Transport {
     /// Collatz–Wielandt bounds on the spectral radius of M per channel (lower, upper); computed
     /// for Infinite and Auto only.
     pub spectral_bounds: Vec<(f64, f64)>,
-}
-
-impl Transport {
-    /// `(S · e)_i` for channel `c` (a grey transport serves every channel).
-    pub fn apply(&self, c: usize, e: &[f64]) -> Vec<f64> {
-        let c = c.min(self.channels - 1);
-        let m = &self.values[c * self.n * self.n..(c + 1) * self.n * self.n];
-        (0..self.n)
-            .map(|i| {
-                m[i * self.n..(i + 1) * self.n]
-                    .iter()
-                    .zip(e)
-                    .map(|(&s, &x)| s as f64 * x)
-                    .sum()
-            })
-            .collect()
-    }
 }
 
 /// Estimated peak bytes of [`transport`]: the form factors, the output, and the working
@@ -137,10 +118,9 @@ pub fn transport(
         memory_estimate(n, channels, params.bounces),
         params.max_memory,
     )?;
+    let mut values = Vec::with_capacity(channels * n * n);
     let mut out = Transport {
-        channels,
-        n,
-        values: Vec::with_capacity(channels * n * n),
+        matrix: TransportMatrix::zeros(channels, 0),
         bounces: Vec::new(),
         products: 0,
         spectral_bounds: Vec::new(),
@@ -170,11 +150,12 @@ pub fn transport(
         out.bounces.push(k);
         out.products += products;
         for i in 0..n {
-            out.values.extend((0..n).map(|j| s[(i, j)]));
+            values.extend((0..n).map(|j| s[(i, j)]));
         }
         progress.advance(1);
     }
     progress.finish();
+    out.matrix = TransportMatrix::new(channels, n, values)?;
     Ok(out)
 }
 

@@ -69,7 +69,7 @@ pub fn gather_dense(matrix: &[f32], channels: usize, n: usize, e: &[[f32; 3]]) -
 }
 
 /// Per-corner indirect exitance (3 floats per corner) from per-patch values: the twin of
-/// `shaders/corner_transfer.wgsl`.
+/// `shaders/corner_interpolate.wgsl`.
 pub fn corner_indirect(set: &PatchSet, b: &[[f32; 3]]) -> Vec<f32> {
     let lists = &set.corners;
     let mut out = Vec::with_capacity(lists.len() * 3);

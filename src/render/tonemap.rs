@@ -19,6 +19,11 @@ pub fn tonemap(rgb: [f32; 3], exposure: f32) -> [f32; 3] {
     })
 }
 
+/// Encode linear [0, 1] as 8-bit sRGB (the one sRGB encoder: [`linear_to_srgb`], then [`to_u8`]).
+pub fn linear_to_srgb8(v: f32) -> u8 {
+    to_u8(linear_to_srgb(v.clamp(0.0, 1.0)))
+}
+
 /// Quantise a display value to 8 bits (round to nearest), as a `Rgba8Unorm` target does.
 pub fn to_u8(c: f32) -> u8 {
     (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8

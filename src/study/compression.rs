@@ -14,12 +14,13 @@ use super::{relative, Column, ErrorStats, Format, Measure, Setting, Sweep};
 use crate::compress::report::{entry_errors, rms_relative, standard_lights};
 use crate::compress::{
     compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric,
-    ReorderOptions, TransportMatrix,
+    ReorderOptions,
 };
+use crate::radiosity::TransportMatrix;
 use crate::error::Result;
 use crate::progress::Progress;
 use crate::radiosity::formfactor::FormFactorParams;
-use crate::radiosity::patches::Resolution;
+use crate::radiosity::voxelize::Resolution;
 use crate::radiosity::transport::Bounces;
 use crate::radiosity::PatchSet;
 use crate::scene::Scene;
@@ -105,25 +106,24 @@ pub fn input_from_scene(
     name: &str,
 ) -> Result<CompressionInput> {
     let b = bake_scene(scene, resolution, ff, bounces)?;
-    let emitters = emitter_light(&b.set, b.transport.channels);
+    let emitters = emitter_light(&b.set, b.transport.matrix.channels);
     let description = format!(
         "{name}: {} patches, {:?} form factors ({} samples), bounces {bounces:?}, {} channel(s)",
         b.set.len(),
         ff.estimator,
         ff.samples,
-        b.transport.channels
+        b.transport.matrix.channels
     );
-    let s = TransportMatrix::new(b.transport.channels, b.transport.n, b.transport.values)?;
-    Ok(with_standard_lights(s, emitters, description))
+    Ok(with_standard_lights(b.transport.matrix, emitters, description))
 }
 
 /// The transport of an existing bake (`transport.npy`; the emitters from `patches.bin` when it
 /// is there).
 pub fn input_from_bake(dir: &Path) -> Result<CompressionInput> {
-    let s = TransportMatrix::read_npy(&dir.join(crate::radiosity::TRANSPORT_FILE))?;
-    let patches = dir.join(crate::radiosity::PATCHES_FILE);
+    let s = crate::baked::transport::read(dir)?;
+    let patches = dir.join(crate::baked::patches::FILE);
     let emitters = if patches.exists() {
-        let set = crate::radiosity::stages::read_patches(&patches)?;
+        let set = crate::baked::patches::read(dir)?;
         (set.len() == s.n)
             .then(|| emitter_light(&set, s.channels))
             .flatten()

@@ -16,6 +16,7 @@
 //! ([`plot`]). Everything in a report is deterministic except the measured times.
 
 pub mod compression;
+pub mod inputs;
 pub mod plot;
 pub mod radiosity;
 pub mod report;

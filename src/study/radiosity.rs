@@ -22,7 +22,7 @@ use crate::progress::{Progress, Silent};
 use crate::radiosity::formfactor::{form_factors, Estimator, FormFactorParams, FormFactors};
 use crate::radiosity::geometry::dominant_axis;
 use crate::radiosity::locate::PatchLocator;
-use crate::radiosity::patches::{voxelize, Resolution, VoxelizeParams};
+use crate::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use crate::radiosity::reference::{gauss_seidel, indirect};
 use crate::radiosity::transport::{transport, Bounces, Power, Transport, TransportParams};
 use crate::radiosity::PatchSet;
@@ -159,7 +159,7 @@ pub fn emitted_exitance(set: &PatchSet) -> [Vec<f64>; 3] {
 
 /// Gathered indirect light `S·E` per channel, `[3][n]`.
 pub fn gathered(t: &Transport, e: &[Vec<f64>; 3]) -> [Vec<f64>; 3] {
-    std::array::from_fn(|c| t.apply(c, &e[c]))
+    std::array::from_fn(|c| t.matrix.apply(c, &e[c]))
 }
 
 /// Channel-major flattening of a per-patch RGB quantity, and the matching area weights.
@@ -271,7 +271,7 @@ pub fn patch_sweep(scene: &Scene, cfg: &RadiosityConfig, progress: &dyn Progress
             ErrorStats::of(&a.concat(), &r.concat(), Some(&weights)),
         );
         s.seconds = b.voxelize_seconds + b.form_factor_seconds + b.transport_seconds;
-        s.bytes = (b.transport.channels * b.set.len() * b.set.len() * 4) as u64;
+        s.bytes = (b.transport.matrix.channels * b.set.len() * b.set.len() * 4) as u64;
         for (k, v) in [
             ("patches", b.set.len() as f64),
             ("rays", b.f.rays as f64),
@@ -475,7 +475,7 @@ pub fn bounce_sweep(
             ErrorStats::of(&light, &reference, Some(&weights)),
         );
         s.seconds = secs;
-        s.bytes = (t.channels * n * n * 4) as u64;
+        s.bytes = (t.matrix.channels * n * n * 4) as u64;
         s.extra.insert("products".into(), t.products as f64);
         s.extra.insert(
             "bounces_accumulated".into(),

@@ -4,7 +4,7 @@
 
 use super::{plot, Column, Format, Setting, Study, Sweep};
 use crate::error::{Error, IoContext, Result};
-use crate::terrain::images::write_atomic;
+use crate::baked::images::write_atomic;
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -7,7 +7,7 @@ use crate::heightmap::HeightMap;
 use serde::{Deserialize, Serialize};
 
 /// Which map to generate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Shape {
     /// Five thin cones (base radius N/64, heights N/8..N/4) on flat ground.

@@ -2,13 +2,12 @@
 //!
 //! - [`sun`]: the sun direction and its track in texel space (the constants every kernel uses);
 //! - [`exact_traversal`]: hard shadows by visiting every texel on the track (algorithm A1, the reference);
-//! - [`minmax_mipmap`]: the min/max mipmap (the `minmax_mipmap` pipeline stage);
+//! - [`minmax_mipmap`]: the min/max mipmap (stored by `crate::baked::mipmap`);
 //! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
 //! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
 //! - [`relief`]: whole-image shadow masks and shaded relief;
 //! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
 //! - [`generate`]: synthetic height maps (stress maps and analytic shapes);
-//! - [`images`]: writing masks and reliefs (PNG/EXR) atomically.
 //!
 //! Per-pixel kernels are plain loops over flat arrays (no recursion, no allocation) so that
 //! the GPU player can port them line by line to WGSL.
@@ -17,9 +16,7 @@ pub mod accelerated_traversal;
 pub mod exact_traversal;
 pub mod generate;
 pub mod hard_f32;
-pub mod images;
 pub mod minmax_mipmap;
-pub mod mipmap_stage;
 pub mod relief;
 pub mod soft;
 pub mod sun;

@@ -14,8 +14,9 @@ use crate::error::{Error, Result};
 /// track deviates from the true one by less than 2e-5 texels.
 pub const AXIS_SNAP: f64 = 1e-12;
 
-/// The sun as a direction: azimuth and elevation in degrees.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The sun as a direction: azimuth and elevation in degrees. The one sun model of relume: the
+/// terrain kernels use its f64 direction, the GPU its f32 view [`Sun::toward_y_up`].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Sun {
     /// Degrees clockwise from north (any finite value; wrapped).
     pub azimuth_deg: f64,
@@ -47,6 +48,16 @@ impl Sun {
         let (sa, ca) = self.azimuth_deg.to_radians().sin_cos();
         let (se, ce) = self.elevation_deg.to_radians().sin_cos();
         [sa * ce, ca * ce, se]
+    }
+
+    /// f32 view for a y-up scene whose north is −z (the player's mesh scenes):
+    /// (sin az · cos el, sin el, −cos az · cos el), evaluated in f32.
+    pub fn toward_y_up(&self) -> glam::Vec3 {
+        let (az, el) = (
+            (self.azimuth_deg as f32).to_radians(),
+            (self.elevation_deg as f32).to_radians(),
+        );
+        glam::Vec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos())
     }
 
     /// s · up = sin(elevation).

@@ -12,21 +12,12 @@ use relume::error::exit;
 use relume::heightmap::{HeightMapOptions, NoDataPolicy};
 use relume::load::{load_any, summarize_heightmap, summarize_scene, LoadedInput};
 use relume::scene::SceneOptions;
-use relume::{Error, Result};
+use relume::Result;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use ui::Ui;
 
-const EXIT_CODES: &str = "\
-Exit codes:
-  0  success
-  1  internal error (a bug in relume: please report it)
-  2  usage error (bad command line)
-  3  invalid input (malformed file, NaN height, out-of-range knob)
-  4  I/O error (cannot read or write a file)
-  5  over a resource limit (e.g. --max-memory)
-  6  unsupported (valid input that this version cannot handle)
-  7  verification failed (inspect: a missing, truncated or altered file)";
+const EXIT_CODES: &str = exit::HELP;
 
 #[derive(Parser)]
 #[command(
@@ -120,58 +111,36 @@ struct LoadKnobs {
     /// Height map: metres per file unit
     #[arg(long, value_name = "S")]
     height_scale: Option<f64>,
-    /// Height map: what to do with no-data texels
-    #[arg(long, value_enum, default_value_t = NoDataArg::Error)]
-    nodata: NoDataArg,
+    /// Height map: what to do with no-data texels (default: error)
+    #[arg(long, value_enum)]
+    nodata: Option<NoDataPolicy>,
     /// Height map: extra value (in file units) that marks missing data
     #[arg(long, value_name = "V")]
     nodata_value: Option<f64>,
     /// Height map: box-filter down by this integer factor after loading (cell size grows)
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    downsample: u32,
+    #[arg(long, value_parser = relume::pipeline::checks::arg::at_least_one)]
+    downsample: Option<u32>,
     /// Height map: size of a raw little-endian f32 file, WIDTHxHEIGHT
-    #[arg(long, value_name = "WxH", value_parser = parse_wxh)]
+    #[arg(long, value_name = "WxH", value_parser = relume::pipeline::checks::arg::wxh)]
     raw_size: Option<(usize, usize)>,
-}
-
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum NoDataArg {
-    Error,
-    FillMin,
-    FillNearest,
 }
 
 impl LoadKnobs {
     fn heightmap_options(&self) -> HeightMapOptions {
+        let d = HeightMapOptions::default();
         HeightMapOptions {
             cell_size: self.cell_size.map(|c| [c, c]),
             height_scale: self.height_scale,
             nodata_value: self.nodata_value,
-            nodata: match self.nodata {
-                NoDataArg::Error => NoDataPolicy::Error,
-                NoDataArg::FillMin => NoDataPolicy::FillMin,
-                NoDataArg::FillNearest => NoDataPolicy::FillNearest,
-            },
+            nodata: self.nodata.unwrap_or(d.nodata),
             raw_size: self.raw_size.map(|(w, h)| [w, h]),
-            downsample: self.downsample,
+            downsample: self.downsample.unwrap_or(d.downsample),
         }
     }
 }
 
 fn parse_size(s: &str) -> std::result::Result<u64, String> {
     relume::limits::parse_bytes(s)
-}
-
-fn parse_wxh(s: &str) -> std::result::Result<(usize, usize), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{s}` is not WIDTHxHEIGHT (e.g. 1024x512)"))?;
-    let w: usize = w.parse().map_err(|_| format!("`{w}` is not a width"))?;
-    let h: usize = h.parse().map_err(|_| format!("`{h}` is not a height"))?;
-    if w == 0 || h == 0 {
-        return Err("width and height must be at least 1".into());
-    }
-    Ok((w, h))
 }
 
 fn main() {
@@ -207,7 +176,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             max_memory,
         } => {
             let p = relume::pipeline::parse_pipeline(pipeline)?;
-            let out = output_dir(pipeline, &p, out.as_deref());
+            let out = relume::pipeline::output_dir(pipeline, &p, out.as_deref());
             let mut opts = relume::bake::BakeOptions::default();
             if let Some(m) = max_memory {
                 opts.max_memory = *m;
@@ -228,42 +197,26 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         }
         Command::Plan { pipeline, out } => {
             let p = relume::pipeline::parse_pipeline(pipeline)?;
-            let out = output_dir(pipeline, &p, out.as_deref());
+            let out = relume::pipeline::output_dir(pipeline, &p, out.as_deref());
             let input = relume::load::load_input(&p.input)?;
-            let plan = relume::pipeline::plan(&p, &input, &out);
+            let plan = relume::bake::plan(&p, &input, &out);
             if json {
                 print_json(&plan);
             } else {
-                println!(
-                    "pipeline {}: {} input {}",
-                    pipeline.display(),
-                    plan.input_kind,
-                    plan.input
-                );
-                println!("output   {}", plan.output.display());
-                println!(
-                    "{:<16} {:>12} {:>12}  notes",
-                    "stage", "peak memory", "writes"
-                );
-                for s in &plan.stages {
-                    println!(
-                        "{:<16} {:>12} {:>12}  {}",
-                        s.stage,
-                        relume::limits::human_bytes(s.peak_bytes),
-                        relume::limits::human_bytes(s.output_bytes),
-                        s.notes
-                    );
-                }
-                println!(
-                    "total: peak {} (budget {}), writes {}",
-                    relume::limits::human_bytes(plan.peak_bytes),
-                    relume::limits::human_bytes(relume::limits::default_max_memory()),
-                    relume::limits::human_bytes(plan.output_bytes)
-                );
+                print!("{}", plan.to_text(pipeline));
             }
             Ok(exit::OK)
         }
-        Command::Inspect { baked_dir } => inspect(baked_dir, json),
+        Command::Inspect { baked_dir } => {
+            let i = relume::baked::manifest::Inspection::of(baked_dir)?;
+            if json {
+                print_json(&i);
+            } else {
+                print!("{}", i.to_text());
+            }
+            i.result()?;
+            Ok(exit::OK)
+        }
         Command::Radiosity(c) => radiosity::run(c, json, cli.global.quiet, ui),
         Command::Compress(c) => compress::run(c, ui, json, cli.global.quiet),
         Command::Study(a) => study::run(a, ui, json, cli.global.quiet),
@@ -285,29 +238,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
                     if json {
                         print_json(&s);
                     } else {
-                        println!("scene      {}", s.path);
-                        println!(
-                            "triangles  {} ({} degenerate), vertices {}",
-                            s.triangles, s.degenerate_triangles, s.vertices
-                        );
-                        println!("objects    {}", s.objects.join(", "));
-                        println!("materials  {}", s.materials.len());
-                        for m in &s.materials {
-                            println!(
-                                "  {:<16} albedo {:?}  emission {:?}",
-                                m.name, m.albedo, m.emission
-                            );
-                        }
-                        println!("lights     {}", s.lights.len());
-                        for l in &s.lights {
-                            println!(
-                                "  {:<16} {:?} intensity {} colour {:?}",
-                                l.name, l.kind, l.intensity, l.color
-                            );
-                        }
-                        println!("bounds     {:?} .. {:?}", s.bounds_min, s.bounds_max);
-                        println!("area       {:.6}", s.total_area);
-                        println!("grey       {}", s.grey);
+                        print!("{}", s.to_text());
                     }
                 }
                 LoadedInput::HeightMap(map, info) => {
@@ -315,17 +246,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
                     if json {
                         print_json(&s);
                     } else {
-                        println!("height map {} ({} {})", s.path, s.format, s.sample);
-                        println!("size       {} x {}", s.width, s.height);
-                        println!(
-                            "cell size  {} x {} m ({})",
-                            s.cell_size[0], s.cell_size[1], s.cell_size_source
-                        );
-                        println!(
-                            "heights    {} .. {} m (height scale {})",
-                            s.min, s.max, s.height_scale
-                        );
-                        println!("no-data    {}", s.nodata_count);
+                        print!("{}", s.to_text());
                     }
                 }
             }
@@ -334,85 +255,23 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
     }
 }
 
-/// `--out`, else the pipeline's `output`, else `out/<pipeline file stem>`.
-fn output_dir(pipeline_path: &Path, p: &relume::pipeline::Pipeline, out: Option<&Path>) -> PathBuf {
-    if let Some(o) = out {
-        return o.to_path_buf();
-    }
-    if let Some(o) = &p.output {
-        return o.clone();
-    }
-    let stem = pipeline_path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "bake".into());
-    PathBuf::from("out").join(stem)
-}
-
-#[derive(Serialize)]
-struct InspectReport<'a> {
-    dir: String,
-    ok: bool,
-    manifest: &'a relume::baked::Manifest,
-    problems: Vec<relume::baked::VerifyProblem>,
-}
-
-fn inspect(dir: &Path, json: bool) -> Result<i32> {
-    let manifest = relume::baked::Manifest::read(dir)?;
-    let problems = relume::baked::verify(dir, &manifest);
-    let ok = problems.is_empty();
+/// What a stage run alone on a bake did: JSON, or one line per stage with its measurements.
+fn print_stage_report(report: &relume::bake::BakeReport, dir: &Path, json: bool, quiet: bool) {
     if json {
-        print_json(&InspectReport {
-            dir: dir.display().to_string(),
-            ok,
-            manifest: &manifest,
-            problems: problems.clone(),
-        });
-    } else {
-        println!("baked dir  {}", dir.display());
-        println!(
-            "format     v{} (relume {})",
-            manifest.format_version, manifest.relume_version
-        );
-        println!(
-            "input      {} ({} bytes, sha256 {})",
-            manifest.input.name,
-            manifest.input.bytes,
-            &manifest.input.sha256[..16]
-        );
-        for s in &manifest.stages {
-            println!("stage      {}  → {}", s.stage, s.outputs.join(", "));
-            for (k, v) in &s.report {
-                println!("  {k:<28} {v}");
-            }
-            for (k, v) in &s.facts {
-                println!("  {k:<28} {v}");
-            }
-        }
-        for f in &manifest.files {
-            let status = problems
-                .iter()
-                .find(|p| p.file == f.name)
-                .map(|p| p.problem.as_str())
-                .unwrap_or("ok");
-            println!(
-                "file       {:<28} {:>12} bytes  {}",
-                f.name, f.bytes, status
+        print_json(report);
+    } else if !quiet {
+        for s in &report.stages {
+            eprintln!(
+                "ran {} on {} in {:.2} s → {}",
+                s.stage,
+                dir.display(),
+                s.seconds,
+                s.outputs.join(", ")
             );
+            for (k, v) in &s.report {
+                eprintln!("  {k:<28} {v}");
+            }
         }
-    }
-    if ok {
-        Ok(exit::OK)
-    } else {
-        let first = &problems[0];
-        Err(Error::verify(
-            dir.join(&first.file),
-            format!(
-                "{} ({} problem(s) in this bake)",
-                first.problem,
-                problems.len()
-            ),
-        ))
     }
 }
 

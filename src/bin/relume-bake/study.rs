@@ -5,15 +5,9 @@
 use crate::ui::Ui;
 use clap::{Args, Subcommand};
 use relume::error::exit;
-use relume::heightmap::HeightMap;
-use relume::pipeline::{Input, Pipeline, Stage};
-use relume::radiosity::formfactor::{Estimator, FormFactorParams};
-use relume::radiosity::patches::Resolution;
-use relume::radiosity::transport::Bounces;
-use relume::scene::{load_scene, Scene, SceneOptions};
-use relume::study::{self, compression, radiosity, report, terrain, Study};
-use relume::{Error, Result};
-use std::path::{Path, PathBuf};
+use relume::study::{self, compression, inputs, radiosity, report, terrain, Study};
+use relume::Result;
+use std::path::PathBuf;
 
 const STUDY_HELP: &str = "\
 Writes DIR/study.json (every setting: knobs, errors, seconds, bytes), DIR/study.md (a table per
@@ -142,105 +136,12 @@ fn elevation(s: &str) -> std::result::Result<f64, String> {
     }
 }
 
-/// A bundled file: relative to the current directory, else to the source tree relume was built
-/// from.
-fn bundled(rel: &str) -> Result<PathBuf> {
-    let here = PathBuf::from(rel);
-    if here.exists() {
-        return Ok(here);
+fn source(s: &SceneSource) -> inputs::SceneSource {
+    inputs::SceneSource {
+        pipeline: s.pipeline.clone(),
+        scene: s.scene.clone(),
+        scale: s.scale,
     }
-    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
-    if built.exists() {
-        return Ok(built);
-    }
-    Err(Error::input(
-        rel,
-        "the bundled default input is not here nor in the source tree relume was built from; name an input explicitly",
-    ))
-}
-
-/// The scene to study and a description of it; the pipeline when one was given.
-fn scene_of(src: &SceneSource) -> Result<(Scene, String, Option<Pipeline>)> {
-    if let Some(p) = &src.pipeline {
-        let pipeline = relume::pipeline::parse_pipeline(p)?;
-        let Input::Scene(s) = &pipeline.input else {
-            return Err(Error::input(
-                p,
-                "this pipeline's input is a height map; the radiosity and compression studies need a scene",
-            ));
-        };
-        let (scene, _) = load_scene(&s.path, s.options())?;
-        return Ok((
-            scene,
-            format!("the scene of {}", p.display()),
-            Some(pipeline),
-        ));
-    }
-    let (path, scale) = match &src.scene {
-        Some(s) => (s.clone(), src.scale.unwrap_or(1.0)),
-        None => (bundled("scenes/cornell-box/cornell_box.obj")?, 0.001),
-    };
-    let (scene, _) = load_scene(&path, SceneOptions { scale })?;
-    Ok((scene, format!("{} (scale {scale})", path.display()), None))
-}
-
-fn map_of(args: &TerrainArgs) -> Result<(HeightMap, String)> {
-    // The same loading (pipeline knobs, overrides) as `shadow` and `softshadow`.
-    let (input, name) = match (&args.heightmap, &args.pipeline) {
-        (Some(h), _) => (h.clone(), h.display().to_string()),
-        (None, p) => {
-            let p = match p {
-                Some(p) => p.clone(),
-                None => bundled("pipelines/puget-sound.ron")?,
-            };
-            let name = format!("the height map of {}", p.display());
-            (p, name)
-        }
-    };
-    let map = crate::terrain::load_map(&crate::terrain::MapArgs {
-        input,
-        cell_size: args.cell_size,
-        height_scale: args.height_scale,
-    })?;
-    let name = format!(
-        "{name}: {}x{}, cell {} x {} m",
-        map.width, map.height, map.cell_size[0], map.cell_size[1]
-    );
-    Ok((map, name))
-}
-
-/// The compression study's matrix: a bake's, or one baked from the scene with the pipeline's
-/// (else default) knobs.
-fn compression_input(args: &CompressionArgs, quick: bool) -> Result<compression::CompressionInput> {
-    if let Some(dir) = &args.baked {
-        return compression::input_from_bake(dir);
-    }
-    let (scene, name, pipeline) = scene_of(&args.source)?;
-    let mut resolution = Resolution::TargetPatches(if quick { 300 } else { 1000 });
-    let mut ff = FormFactorParams {
-        estimator: Estimator::Hemisphere,
-        samples: if quick { 512 } else { 4096 },
-        seed: 0,
-    };
-    let mut bounces = Bounces::Infinite;
-    for stage in pipeline.iter().flat_map(|p| &p.stages) {
-        match stage {
-            Stage::Voxelize(k) => resolution = k.resolution,
-            Stage::FormFactors(k) => {
-                ff = FormFactorParams {
-                    estimator: k.estimator,
-                    samples: k.samples.unwrap_or_else(|| k.estimator.default_samples()),
-                    seed: k.seed,
-                }
-            }
-            Stage::Transport(k) => bounces = k.bounces,
-            _ => {}
-        }
-    }
-    if let Some(n) = args.patches {
-        resolution = Resolution::TargetPatches(n);
-    }
-    compression::input_from_scene(&scene, resolution, &ff, bounces, &name)
 }
 
 /// `relume-bake study ...`.
@@ -254,7 +155,7 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
     report::prepare_dir(out)?;
     let mut study = match &args.which {
         Which::Radiosity(a) => {
-            let (scene, name, _) = scene_of(&a.source)?;
+            let (scene, name, _) = inputs::scene(&source(&a.source))?;
             let mut cfg = if quick {
                 radiosity::RadiosityConfig::quick()
             } else {
@@ -266,7 +167,7 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
             Study::new("radiosity", name, quick, radiosity::run(&scene, &cfg, ui)?)
         }
         Which::Compression(a) => {
-            let input = compression_input(a, quick)?;
+            let input = inputs::compression_input(a.baked.as_deref(), &source(&a.source), a.patches, quick)?;
             let cfg = if quick {
                 compression::CompressionConfig::quick()
             } else {
@@ -276,7 +177,7 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
             Study::new("compression", input.description.clone(), quick, sweeps)
         }
         Which::Terrain(a) => {
-            let (map, name) = map_of(a)?;
+            let (map, name) = inputs::heightmap(a.heightmap.as_deref(), a.pipeline.as_deref(), a.cell_size, a.height_scale)?;
             let mut cfg = if quick {
                 terrain::TerrainConfig::quick()
             } else {

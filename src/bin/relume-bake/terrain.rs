@@ -3,15 +3,16 @@
 
 use crate::ui::Ui;
 use clap::{Args, ValueEnum};
+use relume::render::tonemap::linear_to_srgb8;
 use relume::error::exit;
-use relume::heightmap::{load_heightmap, HeightMap, HeightMapOptions};
+use relume::heightmap::HeightMap;
 use relume::progress::Progress;
 use relume::terrain::generate::{generate, quantise_u16, Shape};
-use relume::terrain::images::{self, check_extension};
+use relume::baked::images::{self, check_extension};
 use relume::terrain::relief::{self, HardMethod};
 use relume::terrain::soft::{soft_shadow_map, SoftMethod, SoftShadowParams};
 use relume::terrain::Sun;
-use relume::{Error, Result};
+use relume::Result;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -47,14 +48,6 @@ pub struct SunArgs {
     pub sun_elevation: f64,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-pub enum HardMethodArg {
-    /// Every texel on the track (the reference)
-    Exact,
-    /// Over the min/max mipmap (same answer, faster)
-    Accelerated,
-}
-
 #[derive(Args)]
 #[command(after_help = SUN_HELP)]
 pub struct ShadowArgs {
@@ -63,8 +56,8 @@ pub struct ShadowArgs {
     #[command(flatten)]
     pub sun: SunArgs,
     /// Traversal method
-    #[arg(long, value_enum, default_value_t = HardMethodArg::Accelerated)]
-    pub method: HardMethodArg,
+    #[arg(long, value_enum, default_value_t = HardMethod::default())]
+    pub method: HardMethod,
     /// Shadow mask to write (.png: white = lit, black = shadow)
     #[arg(long, value_name = "MASK.png")]
     pub out: PathBuf,
@@ -100,7 +93,7 @@ impl ReliefArgs {
     fn write(&self, map: &HeightMap, sun: &Sun, shadow: &[f32]) -> Result<()> {
         if let Some(path) = &self.shaded {
             let relief = relief::shaded_relief(map, sun, shadow, self.k_dark, self.k_bright);
-            let px = relief.into_iter().map(images::linear_to_srgb8).collect();
+            let px = relief.into_iter().map(linear_to_srgb8).collect();
             images::write_png_gray8(path, map.width, map.height, px)?;
         }
         Ok(())
@@ -111,26 +104,11 @@ impl ReliefArgs {
     }
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-pub enum ShapeArg {
-    /// Five thin tall cones (the seed's stress map)
-    Spikes,
-    /// Sharp terraces (the seed's stress map)
-    Steps,
-    Flat,
-    /// A north-south wall
-    Wall,
-    Cone,
-    Hemisphere,
-    /// A hemispherical bowl
-    Crater,
-}
-
 #[derive(Args)]
 pub struct GenerateArgs {
     /// Which map
     #[arg(value_enum)]
-    pub shape: ShapeArg,
+    pub shape: Shape,
     /// Width and height in texels (cell size 1 m; feature heights scale with it)
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=32768))]
     pub size: u32,
@@ -262,33 +240,7 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
 
 /// Load the input of a terrain command: a height map, or a pipeline's height-map input.
 pub fn load_map(args: &MapArgs) -> Result<HeightMap> {
-    let is_pipeline = args
-        .input
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
-    let mut opts = if is_pipeline {
-        let p = relume::pipeline::parse_pipeline(&args.input)?;
-        match &p.input {
-            relume::pipeline::Input::HeightMap(h) => (h.path.clone(), h.options()),
-            relume::pipeline::Input::Scene(_) => {
-                return Err(Error::input(
-                    &args.input,
-                    "this pipeline's input is a scene; terrain commands need a height map",
-                ))
-            }
-        }
-    } else {
-        (args.input.clone(), HeightMapOptions::default())
-    };
-    if let Some(c) = args.cell_size {
-        opts.1.cell_size = Some([c, c]);
-    }
-    if let Some(s) = args.height_scale {
-        opts.1.height_scale = Some(s);
-    }
-    let (map, _) = load_heightmap(&opts.0, &opts.1)?;
-    Ok(map)
+    relume::load::heightmap_input(&args.input, args.cell_size, args.height_scale)
 }
 
 fn print_json(v: &serde_json::Value) {
@@ -303,10 +255,7 @@ pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32
     ui.begin("load", 0);
     let map = load_map(&args.map)?;
     ui.finish();
-    let method = match args.method {
-        HardMethodArg::Exact => HardMethod::Exact,
-        HardMethodArg::Accelerated => HardMethod::Accelerated,
-    };
+    let method = args.method;
     let t0 = Instant::now();
     let mask = relief::shadow_mask(&map, &sun, method, None, ui);
     let seconds = t0.elapsed().as_secs_f64();
@@ -348,15 +297,7 @@ pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32
 /// `relume-bake generate`.
 pub fn generate_cmd(args: &GenerateArgs, quiet: bool, json: bool) -> Result<i32> {
     check_extension(&args.out, &["png", "exr"])?;
-    let shape = match args.shape {
-        ShapeArg::Spikes => Shape::Spikes,
-        ShapeArg::Steps => Shape::Steps,
-        ShapeArg::Flat => Shape::Flat,
-        ShapeArg::Wall => Shape::Wall,
-        ShapeArg::Cone => Shape::Cone,
-        ShapeArg::Hemisphere => Shape::Hemisphere,
-        ShapeArg::Crater => Shape::Crater,
-    };
+    let shape = args.shape;
     let n = args.size as usize;
     relume::limits::check_memory(
         "this height map",

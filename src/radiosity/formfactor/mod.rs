@@ -17,7 +17,7 @@ pub mod hemisphere;
 pub mod pairwise;
 
 use super::locate::PatchLocator;
-use super::patches::{live_triangles, piece_sampler};
+use super::voxelize::{live_triangles, piece_sampler};
 use super::visibility::Visibility;
 use super::PatchSet;
 use crate::error::{Error, Result};
@@ -26,7 +26,7 @@ use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 
 /// Which form-factor estimator to use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 pub enum Estimator {
     /// N cosine-distributed rays from each patch (N = samples).
     #[default]
@@ -110,7 +110,7 @@ pub fn form_factors(
         return Err(Error::knob("form_factors: samples must be at least 1"));
     }
     if set.is_empty() {
-        return Err(Error::input(super::PATCHES_FILE, "no patches"));
+        return Err(Error::input("patches", "no patches"));
     }
     let ctx = Context::new(scene, set);
     Ok(match params.estimator {

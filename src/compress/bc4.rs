@@ -1,5 +1,4 @@
-//! Per-block codecs of the dense part other than BC1: BC4 (one channel, 8 bytes per block),
-//! BC6H (unsigned half-float RGB, 16 bytes per block), F16 and F32 texels.
+//! BC4: one channel, 8 bytes per block.
 //!
 //! BC4 ([`bc4_palette`]): endpoints `r0`, `r1` are bytes 0 and 1; sixteen 3-bit indices follow
 //! (texel `t` in bits `3t..3t+3` of the 48-bit little-endian integer at bytes 2..8). If
@@ -7,7 +6,6 @@
 //! `r0, r1, ((5−k)·r0 + k·r1)/5` for k = 1..4, then 0 and 255. Values are kept as real numbers
 //! (the D3D/Vulkan UNORM decode interpolates in float), not rounded to 8 bits.
 //!
-//! BC6H is encoded by intel_tex_2 and decoded by `bcdec_rs` (a port of the public-domain bcdec).
 
 /// The eight palette values of a BC4 block as real codes in [0, 255].
 #[inline]
@@ -67,29 +65,6 @@ pub fn bc4_encode_strip(r8: &[u8], width: usize, dst: &mut [u8]) {
     intel_tex_2::bc4::compress_blocks_into(&surface, dst);
 }
 
-/// Encode a strip of 4 rows of RGBA f16 texels (8 bytes each) into BC6H blocks.
-pub fn bc6h_encode_strip(rgba16: &[u8], width: usize, dst: &mut [u8]) {
-    let surface = intel_tex_2::RgbaSurface {
-        data: rgba16,
-        width: width as u32,
-        height: 4,
-        stride: width as u32 * 8,
-    };
-    let settings = intel_tex_2::bc6h::basic_settings();
-    intel_tex_2::bc6h::compress_blocks_into(&settings, &surface, dst);
-}
-
-/// Decode a BC6H (unsigned) block to 16 RGB f32 texels.
-#[inline]
-pub fn bc6h_decode_block(block: &[u8]) -> [[f32; 3]; 16] {
-    let mut tmp = [0.0f32; 48];
-    bcdec_rs::bc6h_float(block, &mut tmp, 12, false);
-    let mut out = [[0.0f32; 3]; 16];
-    for t in 0..16 {
-        out[t] = [tmp[3 * t], tmp[3 * t + 1], tmp[3 * t + 2]];
-    }
-    out
-}
 
 #[cfg(test)]
 mod tests {

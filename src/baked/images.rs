@@ -1,4 +1,4 @@
-//! Writing terrain images: 8/16-bit grayscale PNG and f32 EXR, always atomically (a temporary
+//! Image outputs (terrain masks, lit fractions, player frames, study plots): 8/16-bit grayscale PNG and f32 EXR, always atomically (a temporary
 //! file beside the target, renamed into place only when complete).
 
 use crate::error::{Error, IoContext, Result};
@@ -33,17 +33,6 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
     }
 }
 
-/// Encode linear [0, 1] as 8-bit sRGB.
-pub fn linear_to_srgb8(v: f32) -> u8 {
-    let v = v.clamp(0.0, 1.0);
-    let s = if v <= 0.0031308 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5) as u8
-}
-
 /// Write an 8-bit grayscale PNG atomically.
 pub fn write_png_gray8(path: &Path, width: usize, height: usize, pixels: Vec<u8>) -> Result<()> {
     let img = image::GrayImage::from_raw(width as u32, height as u32, pixels)
@@ -71,7 +60,7 @@ pub fn write_png_gray16(path: &Path, width: usize, height: usize, pixels: Vec<u1
 /// Write a one-channel (`Y`) f32 EXR atomically.
 pub fn write_exr_gray(path: &Path, width: usize, height: usize, values: &[f32]) -> Result<()> {
     write_atomic(path, |tmp| {
-        crate::baked::exr_io::write_f32_channels(tmp, width, height, &[("Y", values)])
+        super::exr_io::write_f32_channels(tmp, width, height, &[("Y", values)])
     })
 }
 

@@ -29,7 +29,7 @@ const PLANE_DISTANCE: f64 = 0.5;
 
 /// Per-corner transfer lists (`3 * triangle + corner`) for every scene triangle; degenerate
 /// triangles get empty lists. `vis` must be built over the same grid frame as `set`.
-pub fn corner_transfer(scene: &Scene, set: &PatchSet, vis: &Visibility) -> PatchLists {
+pub fn corner_patches(scene: &Scene, set: &PatchSet, vis: &Visibility) -> PatchLists {
     let locator = PatchLocator::new(set, scene);
     let frame = set.frame();
     let degenerate: std::collections::BTreeSet<usize> = scene.degenerate_triangles().collect();

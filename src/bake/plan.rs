@@ -2,8 +2,9 @@
 //! size, computed from the loaded input without writing anything. `run` checks the same estimate
 //! against `--max-memory` before it allocates.
 
-use super::{Pipeline, Stage};
+use super::stages::runner;
 use crate::load::LoadedInput;
+use crate::pipeline::{Pipeline, Stage};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -45,6 +46,39 @@ pub struct PlanState {
     pub patches: u64,
     /// Colour channels the transport needs (1 for grey scenes, 3 otherwise).
     pub channels: u64,
+}
+
+impl Plan {
+    /// The plan as a table for people (`relume-bake plan`).
+    pub fn to_text(&self, pipeline: &Path) -> String {
+        use crate::limits::{default_max_memory, human_bytes};
+        let mut t = format!(
+            "pipeline {}: {} input {}\noutput   {}\n{:<16} {:>12} {:>12}  notes\n",
+            pipeline.display(),
+            self.input_kind,
+            self.input,
+            self.output.display(),
+            "stage",
+            "peak memory",
+            "writes"
+        );
+        for s in &self.stages {
+            t += &format!(
+                "{:<16} {:>12} {:>12}  {}\n",
+                s.stage,
+                human_bytes(s.peak_bytes),
+                human_bytes(s.output_bytes),
+                s.notes
+            );
+        }
+        t += &format!(
+            "total: peak {} (budget {}), writes {}\n",
+            human_bytes(self.peak_bytes),
+            human_bytes(default_max_memory()),
+            human_bytes(self.output_bytes)
+        );
+        t
+    }
 }
 
 /// Estimate the pipeline on a loaded input.
@@ -94,7 +128,7 @@ pub fn plan(pipeline: &Pipeline, input: &LoadedInput, output: &Path) -> Plan {
 fn estimate(stage: &Stage, state: &mut PlanState) -> PlannedStage {
     // A stage's own estimate covers its working memory; what earlier stages keep resident adds.
     let resident = state.resident_bytes;
-    let mut planned = stage.runner().estimate(state);
+    let mut planned = runner(stage).estimate(state);
     planned.peak_bytes += resident;
     planned
 }

@@ -1,13 +1,20 @@
 //! Running a pipeline: load the input, check the plan against the memory budget, run each stage
 //! in order into a [`BakeTransaction`], write the manifest and swap the bake into place.
 
+pub mod plan;
+pub mod stages;
+pub mod workspace;
+
+pub use plan::{plan, Plan, PlanState, PlannedStage};
+
 use crate::baked::{self, manifest::hash_file, BakeTransaction, FileRecord, Manifest, StageRecord};
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::load::{load_input, LoadedInput};
-use crate::pipeline::{plan, Pipeline, Stage};
+use crate::pipeline::{Pipeline, Stage};
 use crate::progress::Progress;
-use crate::workspace::Workspace;
+use stages::runner;
+use workspace::Workspace;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -82,7 +89,7 @@ pub fn run_pipeline(
     }
     for stage in &pipeline.stages {
         let t = Instant::now();
-        let rec = stage.runner().run(&mut ws, &mut txn, progress)?;
+        let rec = runner(stage).run(&mut ws, &mut txn, progress)?;
         timings.push(timing(&rec, t));
         records.push(rec);
     }
@@ -133,8 +140,8 @@ fn write_input(txn: &mut BakeTransaction, input: &LoadedInput) -> Result<StageRe
     };
     match input {
         LoadedInput::Scene(scene, _) => {
-            txn.write(baked::SCENE_FILE, &baked::to_postcard(scene)?)?;
-            rec.outputs.push(baked::SCENE_FILE.into());
+            baked::scene::write(txn, scene)?;
+            rec.outputs.push(baked::scene::FILE.into());
             rec.report
                 .insert("vertices".into(), scene.positions.len() as f64);
             rec.report
@@ -150,8 +157,8 @@ fn write_input(txn: &mut BakeTransaction, input: &LoadedInput) -> Result<StageRe
             rec.facts.insert("grey".into(), scene.is_grey().to_string());
         }
         LoadedInput::HeightMap(map, info) => {
-            txn.write_with(baked::HEIGHTMAP_FILE, |p| baked::write_heightmap(p, map))?;
-            rec.outputs.push(baked::HEIGHTMAP_FILE.into());
+            baked::heightmap::write(txn, map)?;
+            rec.outputs.push(baked::heightmap::FILE.into());
             let (lo, hi) = map.min_max();
             rec.report.insert("width".into(), map.width as f64);
             rec.report.insert("height".into(), map.height as f64);
@@ -237,7 +244,7 @@ pub fn run_stage_on_with(
     let mut ws = Workspace::over_bake(dir, manifest.clone());
     ws.set_memory_budget(opts.max_memory);
     let t = Instant::now();
-    let rec = stage.runner().run(&mut ws, &mut txn, progress)?;
+    let rec = runner(&stage).run(&mut ws, &mut txn, progress)?;
     let timings = vec![timing(&rec, t)];
     records.push(rec);
     pipeline.stages.push(stage);

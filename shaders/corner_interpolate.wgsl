@@ -1,6 +1,6 @@
 // Indirect exitance at every triangle corner: the weighted patches of the corner's transfer list
 // (compressed rows). Writes the mesh shader's per-corner `indirect` vertex buffer.
-// Rust twin: relume::radiosity::transfer::interpolate (per channel).
+// Rust twin: relume::radiosity::corners::interpolate (per channel).
 
 struct TransferParams {
     corners: u32,

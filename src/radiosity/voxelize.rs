@@ -17,7 +17,7 @@
 //! The voxel size is a knob, or it is chosen by bisection so that the number of (voxel, axis)
 //! groups is closest to a target patch count.
 
-use super::geometry::{self, axis_vector, dominant_axis, Frame, Polygon};
+use super::geometry::{self, axis_vector, dominant_axis, group_key, split_key, Frame, Polygon};
 use super::overlap::{self, Face};
 use super::visibility::Visibility;
 use super::{Patch, PatchLists, PatchSet, Piece, SurfacePoint, VoxelizeStats};
@@ -58,7 +58,7 @@ pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
     let degenerate = scene.triangles.len() - live.len();
     if live.is_empty() {
         return Err(Error::input(
-            crate::baked::SCENE_FILE,
+            "scene",
             "the scene has no triangle with positive area: nothing to voxelize",
         ));
     }
@@ -179,7 +179,7 @@ pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
     }
     set.triangle_patches = triangle_map(scene, &set, size);
 
-    set.corners = super::transfer::corner_transfer(scene, &set, &vis);
+    set.corners = super::corners::corner_patches(scene, &set, &vis);
     set.objects = scene.objects.clone();
     set.stats = VoxelizeStats {
         degenerate_triangles: degenerate as u32,
@@ -202,23 +202,6 @@ pub fn live_triangles(scene: &Scene) -> Vec<u32> {
         .collect()
 }
 
-/// Group key of a piece: voxel (x fastest) then axis.
-pub(crate) fn group_key(voxel: [u32; 3], axis: u8, dims: [u32; 3]) -> u64 {
-    let linear =
-        voxel[0] as u64 + dims[0] as u64 * (voxel[1] as u64 + dims[1] as u64 * voxel[2] as u64);
-    linear * 8 + axis as u64
-}
-
-/// Voxel and axis of a group key.
-pub fn split_key(key: u64, dims: [u32; 3]) -> ([u32; 3], u8) {
-    let axis = (key % 8) as u8;
-    let mut l = key / 8;
-    let x = (l % dims[0] as u64) as u32;
-    l /= dims[0] as u64;
-    let y = (l % dims[1] as u64) as u32;
-    let z = (l / dims[1] as u64) as u32;
-    ([x, y, z], axis)
-}
 
 fn lifted_centroid(p: &Piece, lift: f64) -> DVec3 {
     let poly: Vec<DVec3> = p.vertices.iter().map(|&v| DVec3::from(v)).collect();

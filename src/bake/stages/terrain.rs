@@ -1,26 +1,13 @@
-//! The `minmax_mipmap` pipeline stage: build the min/max mipmap of the bake's height map and
-//! write it as `minmax_mipmap.exr` (layout in docs/baked-format.md).
+//! The height-map stages: `minmax_mipmap`.
 
-use super::minmax_mipmap::{level_sizes, MinMaxMipmap};
-use crate::baked::{BakeTransaction, StageRecord};
+use super::{record, StageRun};
+use crate::bake::plan::{PlanState, PlannedStage};
+use crate::bake::workspace::Workspace;
+use crate::baked::{self, BakeTransaction, StageRecord};
 use crate::error::Result;
-use crate::pipeline::{PlanState, PlannedStage, StageRun};
+use crate::pipeline::knobs::MinmaxMipmapKnobs;
 use crate::progress::Progress;
-use crate::workspace::Workspace;
-use serde::{Deserialize, Serialize};
-
-/// File name of the mipmap in a height-map bake.
-pub const MIPMAP_FILE: &str = "minmax_mipmap.exr";
-
-/// Knobs of the `minmax_mipmap` stage (none yet: `MinmaxMipmap()` in a pipeline).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MinmaxMipmapKnobs {}
-
-/// The mipmap of a bake: from this run's workspace or read from the bake's file.
-pub fn mipmap_of(ws: &mut Workspace) -> Result<&MinMaxMipmap> {
-    ws.get(MIPMAP_FILE, MinMaxMipmap::read_exr)
-}
+use crate::terrain::minmax_mipmap::{level_sizes, MinMaxMipmap};
 
 impl StageRun for MinmaxMipmapKnobs {
     fn run(
@@ -31,12 +18,8 @@ impl StageRun for MinmaxMipmapKnobs {
     ) -> Result<StageRecord> {
         progress.begin("minmax_mipmap", 0);
         let mip = MinMaxMipmap::build(ws.heightmap()?);
-        txn.write_with(MIPMAP_FILE, |p| mip.write_exr(p))?;
-        let mut rec = StageRecord {
-            stage: "minmax_mipmap".into(),
-            outputs: vec![MIPMAP_FILE.into()],
-            ..Default::default()
-        };
+        baked::mipmap::write(txn, &mip)?;
+        let mut rec = record("minmax_mipmap", &[baked::mipmap::FILE]);
         rec.report.insert("levels".into(), mip.levels.len() as f64);
         rec.report
             .insert("level0_width".into(), mip.levels[0].width as f64);
@@ -50,7 +33,7 @@ impl StageRun for MinmaxMipmapKnobs {
              bounding 2x2 texels plus a one-texel border; each level halves the previous (2x2 reduction); no 1x1 level"
                 .into(),
         );
-        ws.put(MIPMAP_FILE, mip);
+        ws.set_mipmap(mip);
         progress.finish();
         Ok(rec)
     }

@@ -1,0 +1,141 @@
+//! Reading a bake out for other tools: patches as JSON, matrices as `.npy`, and the CPU gather
+//! from the compressed transport.
+
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::path::Path;
+
+/// What `relume-bake export` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExportWhat {
+    Patches,
+    FormFactors,
+    Transport,
+}
+
+/// A standard light configuration of the encode report (`compress::report::standard_lights`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StandardLight {
+    Uniform,
+    Random,
+    Half,
+    One,
+}
+
+#[derive(Serialize)]
+pub struct PatchesJson {
+    voxel_size: f64,
+    origin: [f64; 3],
+    grid: [u32; 3],
+    patches: Vec<PatchJson>,
+}
+
+#[derive(Serialize)]
+pub struct PatchJson {
+    id: usize,
+    area: f32,
+    centroid: [f32; 3],
+    normal: [f32; 3],
+    axis: &'static str,
+    voxel: [u32; 3],
+    albedo: [f32; 3],
+    emission: [f32; 3],
+    objects: Vec<String>,
+}
+
+/// Export one file of a bake to `out`; returns the file's name.
+pub fn export(dir: &Path, what: ExportWhat, out: &Path) -> Result<&'static str> {
+    let manifest = super::Manifest::read(dir)?;
+    let file = match what {
+        ExportWhat::Patches => super::patches::FILE,
+        ExportWhat::FormFactors => super::form_factors::FILE,
+        ExportWhat::Transport => super::transport::FILE,
+    };
+    if manifest.file(file).is_none() {
+        return Err(Error::input(
+            dir,
+            format!("this bake has no `{file}`; run the stage that writes it first (see `relume-bake inspect`)"),
+        ));
+    }
+    let src = dir.join(file);
+    match what {
+        ExportWhat::Patches => {
+            let set = super::patches::read_file(&src)?;
+            const AXES: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
+            let doc = PatchesJson {
+                voxel_size: set.voxel_size,
+                origin: set.origin,
+                grid: set.dims,
+                patches: set
+                    .patches
+                    .iter()
+                    .enumerate()
+                    .map(|(id, p)| PatchJson {
+                        id,
+                        area: p.area,
+                        centroid: p.centroid,
+                        normal: p.normal,
+                        axis: AXES[p.axis as usize % 6],
+                        voxel: p.voxel,
+                        albedo: p.albedo,
+                        emission: p.emission,
+                        objects: p
+                            .objects
+                            .iter()
+                            .map(|&o| set.objects.get(o as usize).cloned().unwrap_or_default())
+                            .collect(),
+                    })
+                    .collect(),
+            };
+            let text = serde_json::to_string_pretty(&doc)
+                .map_err(|e| Error::Internal(format!("cannot encode JSON: {e}")))?;
+            std::fs::write(out, text).map_err(|e| Error::io(out, "cannot write", e))?;
+        }
+        ExportWhat::FormFactors | ExportWhat::Transport => {
+            let (shape, values) = super::npy::read_npy_f32(&src)?;
+            super::npy::write_npy_f32(out, &shape, &values)?;
+        }
+    }
+    Ok(file)
+}
+
+/// Gather `B_ind = S·E` from the compressed transport of the bake in `dir` for a standard light
+/// or the `[channels, n]` light in `light_npy`, and write it to `out` as `.npy`. Returns
+/// (channels, n).
+pub fn gather(
+    dir: &Path,
+    light: StandardLight,
+    light_npy: Option<&Path>,
+    out: &Path,
+) -> Result<(usize, usize)> {
+    let enc = super::encoded::read(dir)?;
+    let (ch, n) = (enc.dense.channels, enc.dense.n);
+    let e = match light_npy {
+        Some(p) => {
+            let (shape, data) = super::npy::read_npy_f32(p)?;
+            if shape != [ch as u64, n as u64] && !(ch == 1 && shape == [n as u64]) {
+                return Err(Error::input(
+                    p,
+                    format!("light has shape {shape:?}; this bake needs [{ch}, {n}]"),
+                ));
+            }
+            data
+        }
+        None => {
+            let name = match light {
+                StandardLight::Uniform => "uniform",
+                StandardLight::Random => "random",
+                StandardLight::Half => "half",
+                StandardLight::One => "one",
+            };
+            crate::compress::report::standard_lights(ch, n)
+                .into_iter()
+                .find(|(k, _)| k == name)
+                .map(|(_, v)| v)
+                .expect("standard light exists")
+        }
+    };
+    let b = crate::compress::gather(&enc, &e);
+    super::npy::write_npy_f32(out, &[ch as u64, n as u64], &b)?;
+    Ok((ch, n))
+}
