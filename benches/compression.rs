@@ -11,10 +11,8 @@
 mod transport_box;
 
 use relume::compress::report::{self, rms_relative, standard_lights};
-use relume::compress::{
-    compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric,
-    ReorderOptions, TransportMatrix,
-};
+use relume::compress::{compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric, ReorderOptions};
+use relume::radiosity::TransportMatrix;
 use relume::study::timing::median_secs;
 use std::time::Instant;
 

@@ -73,7 +73,7 @@ fn main() {
             s.products,
             flops / secs / 1e9
         );
-        std::hint::black_box(s.values[0]);
+        std::hint::black_box(s.data[0]);
     };
     for k in [1u32, 3, 8, 16] {
         let (h, d) = products(k);

@@ -101,7 +101,7 @@ fn run_writes_a_verified_bake_and_inspect_detects_damage() {
     let m = relume::baked::Manifest::read(&out).unwrap();
     let again = relume::baked::Manifest::from_ron(Path::new("m"), &m.to_ron()).unwrap();
     assert_eq!(m, again);
-    let map = relume::baked::read_heightmap(&out, &m).unwrap();
+    let map = relume::baked::heightmap::read(&out, &m).unwrap();
     assert_eq!(
         (map.width, map.height, map.cell_size),
         (1197, 643, [30.0, 30.0])

@@ -8,10 +8,9 @@ mod transport_box;
 
 use common::{bake, expect_code, python, python_with, text};
 use relume::baked::{manifest::hash_file, FileRecord, Manifest};
-use relume::compress::stages::read_encoded;
-use relume::compress::{
-    bc1, compress, gather, report, DenseEncoding, EncodeOptions, TransportMatrix,
-};
+use relume::baked::encoded::read as read_encoded;
+use relume::compress::{bc1, compress, gather, report, DenseEncoding, EncodeOptions};
+use relume::radiosity::TransportMatrix;
 use std::path::{Path, PathBuf};
 
 /// A scene bake of the Cornell box whose `transport` stage wrote `s` (a synthetic matrix of any
@@ -40,7 +39,7 @@ fn bake_with_transport(tmp: &Path, name: &str, s: &TransportMatrix) -> PathBuf {
         ],
     );
     expect_code(&o, 0);
-    s.write_npy(&dir.join("transport.npy")).unwrap();
+    relume::baked::transport::write_file(&dir.join("transport.npy"), &s).unwrap();
     let mut m = Manifest::read(&dir).unwrap();
     let (bytes, sha256) = hash_file(&dir.join("transport.npy")).unwrap();
     m.files.push(FileRecord {
@@ -139,7 +138,7 @@ fn reorder_encode_gather_round_trip_with_tiles() {
             bnpy.to_str().unwrap(),
         ],
     );
-    let (shape, b) = relume::baked::read_npy_f32(&bnpy).unwrap();
+    let (shape, b) = relume::baked::npy::read_npy_f32(&bnpy).unwrap();
     assert_eq!(shape, vec![3, 96]);
     let enc = read_encoded(&dir).unwrap();
     let light = report::standard_lights(3, 96).remove(1).1;
@@ -360,7 +359,7 @@ fn two_reorder_passes_do_not_increase_the_summed_error_on_the_cornell_box() {
             dir.to_str().unwrap(),
         ],
     );
-    let s = TransportMatrix::read_npy(&dir.join("transport.npy")).unwrap();
+    let s = relume::baked::transport::read_file(&dir.join("transport.npy")).unwrap();
     let mut sums = Vec::new();
     for passes in 0..=2 {
         let perm = reorder(

@@ -6,10 +6,9 @@ mod transport_box;
 
 use proptest::prelude::*;
 use relume::compress::report::{self, rms_relative, standard_lights};
-use relume::compress::{
-    compress, gather, is_permutation, reorder, split_top, DenseEncoding, EncodeOptions,
-    ReorderMetric, ReorderOptions, Sidecar, TransportMatrix,
-};
+use relume::compress::{compress, gather, reorder, split_top, DenseEncoding, EncodeOptions, ReorderMetric, ReorderOptions, Sidecar};
+use relume::radiosity::TransportMatrix;
+use relume::radiosity::matrix::{is_permutation};
 
 fn opts(encoding: DenseEncoding) -> EncodeOptions {
     EncodeOptions {

@@ -5,11 +5,9 @@
 mod common;
 
 use common::{bake, data, expect_code, gpu};
-use relume::compress::stages::read_encoded;
-use relume::compress::{
-    compress, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderOptions,
-    TransportMatrix,
-};
+use relume::baked::encoded::read as read_encoded;
+use relume::compress::{compress, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderOptions};
+use relume::radiosity::TransportMatrix;
 use relume::gpu::compressed_gather::{CompressedGather, DecodePath};
 use relume::gpu::{compute, readback, timing::PassTimer, Gpu};
 
@@ -142,7 +140,7 @@ fn gpu_gather_matches_cpu_gather_for_every_encoding_and_path() {
         );
     }
     // Every encoding of the same matrix, reordered, 4 % sidecar, colour and grey.
-    let s = TransportMatrix::read_npy(&dir.join("transport.npy")).unwrap();
+    let s = relume::baked::transport::read_file(&dir.join("transport.npy")).unwrap();
     let grey = TransportMatrix::new(1, s.n, s.data[s.n * s.n..2 * s.n * s.n].to_vec()).unwrap();
     for m in [&s, &grey] {
         let perm = reorder(

@@ -81,7 +81,7 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     let mut dense_player = Player::load(&gpu, &dir, &opts, w, h).unwrap();
     let camera = dense_player.default_camera();
     dense_player.render(&gpu, &camera, &s, &mut timer).unwrap();
-    let (shape, transport) = relume::baked::read_npy_f32(&dir.join("transport.npy")).unwrap();
+    let (shape, transport) = relume::baked::npy::read_npy_f32(&dir.join("transport.npy")).unwrap();
     let b_dense = gather_dense(&transport, shape[0] as usize, n, &e);
     let Player::Mesh(m) = &dense_player else {
         panic!("a mesh bake")
@@ -99,7 +99,7 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     let mut player = Player::load(&gpu, &dir, &PlayerOptions::default(), w, h).unwrap();
     player.render(&gpu, &camera, &s, &mut timer).unwrap();
     let gpu_img = player.read_image(&gpu).unwrap();
-    let encoded = relume::compress::stages::read_encoded(&dir).unwrap();
+    let encoded = relume::baked::encoded::read(&dir).unwrap();
     let e_flat: Vec<f32> = (0..3).flat_map(|c| e.iter().map(move |v| v[c])).collect();
     let b_flat = relume::compress::gather(&encoded, &e_flat);
     let b: Vec<[f32; 3]> = (0..n)
@@ -471,7 +471,7 @@ fn pipeline_lights_reach_the_bake_and_the_player() {
             ),
             0,
         );
-        let scene: relume::scene::Scene = relume::baked::read_scene(&out).unwrap();
+        let scene: relume::scene::Scene = relume::baked::scene::read(&out).unwrap();
         assert_eq!(scene.lights.len(), usize::from(name == "lit"));
         if gpu().is_none() {
             return;

@@ -107,7 +107,7 @@ fn one_bounce_is_m_and_more_bounces_converge_to_infinity() {
         for i in 0..n {
             for j in 0..n {
                 assert_eq!(
-                    s1.values[c * n * n + i * n + j],
+                    s1.data[c * n * n + i * n + j],
                     albedo[i][c] * f[i * n + j]
                 );
             }
@@ -119,9 +119,9 @@ fn one_bounce_is_m_and_more_bounces_converge_to_infinity() {
     for k in [1u32, 2, 4, 8, 16, 32] {
         let t = run(&f, n, &albedo, Bounces::Finite(k), Power::Auto).unwrap();
         let gap = t
-            .values
+            .data
             .iter()
-            .zip(&inf.values)
+            .zip(&inf.data)
             .map(|(a, b)| (a - b).abs() as f64)
             .fold(0.0, f64::max);
         assert!(gap < last, "k={k}: gap {gap} did not shrink");
@@ -140,9 +140,9 @@ fn one_bounce_is_m_and_more_bounces_converge_to_infinity() {
         auto.bounces
     );
     let gap = auto
-        .values
+        .data
         .iter()
-        .zip(&inf.values)
+        .zip(&inf.data)
         .map(|(a, b)| (a - b).abs())
         .fold(0f32, f32::max);
     assert!(gap < 1e-3, "{gap}");
@@ -194,12 +194,12 @@ fn extremes_of_albedo() {
         Bounces::Auto(1e-6),
     ] {
         let t = run(&f, n, &albedo, b, Power::Auto).unwrap();
-        assert!(t.values.iter().all(|&v| v == 0.0), "{b:?}");
+        assert!(t.data.iter().all(|&v| v == 0.0), "{b:?}");
     }
     // ρ = 0.999 in a closed box: finite, near the furnace value 999.
     let (albedo, f, n) = furnace_box(0.999);
     let t = run(&f, n, &albedo, Bounces::Infinite, Power::Auto).unwrap();
-    assert!(t.values.iter().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(t.data.iter().all(|v| v.is_finite() && *v >= 0.0));
     for v in t.apply(0, &vec![1.0; n]) {
         assert!((v - 999.0).abs() < 0.01 * 999.0, "{v}");
     }
@@ -265,7 +265,7 @@ proptest! {
         let h = run(&f, n, &albedo, Bounces::Finite(k), Power::Horner).unwrap();
         let d = run(&f, n, &albedo, Bounces::Finite(k), Power::Doubling).unwrap();
         prop_assert_eq!(h.channels, 3);
-        for (a, b) in h.values.iter().zip(&d.values) {
+        for (a, b) in h.data.iter().zip(&d.data) {
             prop_assert!((a - b).abs() <= 1e-5 * (1.0 + a.abs()));
         }
         let k1 = run(&f, n, &albedo, Bounces::Finite(k + 1), Power::Horner).unwrap();
@@ -274,15 +274,15 @@ proptest! {
             let o = c * n * n;
             for i in 0..n {
                 for j in 0..n {
-                    let ms: f32 = (0..n).map(|l| m.values[o + i * n + l] * h.values[o + l * n + j]).sum();
-                    let want = m.values[o + i * n + j] + ms;
-                    prop_assert!((k1.values[o + i * n + j] - want).abs() <= 1e-5);
+                    let ms: f32 = (0..n).map(|l| m.data[o + i * n + l] * h.data[o + l * n + j]).sum();
+                    let want = m.data[o + i * n + j] + ms;
+                    prop_assert!((k1.data[o + i * n + j] - want).abs() <= 1e-5);
                 }
             }
         }
         let inf = run(&f, n, &albedo, Bounces::Infinite, Power::Auto).unwrap();
         let far = run(&f, n, &albedo, Bounces::Finite(400), Power::Auto).unwrap();
-        for (a, b) in far.values.iter().zip(&inf.values) {
+        for (a, b) in far.data.iter().zip(&inf.data) {
             prop_assert!((a - b).abs() <= 1e-4);
         }
     }

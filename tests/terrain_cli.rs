@@ -324,8 +324,8 @@ fn pipeline_bakes_the_mipmap_deterministically_and_openexr_reads_it() {
     }
     // The library reads back what it built.
     let m = relume::baked::Manifest::read(&a).unwrap();
-    let map = relume::baked::read_heightmap(&a, &m).unwrap();
-    let mip = relume::terrain::MinMaxMipmap::read_exr(&a.join("minmax_mipmap.exr")).unwrap();
+    let map = relume::baked::heightmap::read(&a, &m).unwrap();
+    let mip = relume::baked::mipmap::read_file(&a.join("minmax_mipmap.exr")).unwrap();
     assert_eq!(mip, relume::terrain::MinMaxMipmap::build(&map));
     let rec = m.stage("minmax_mipmap").unwrap();
     assert_eq!(rec.report["levels"], 10.0);

@@ -1,11 +1,13 @@
 //! Running a pipeline: load the input, check the plan against the memory budget, run each stage
 //! in order into a [`BakeTransaction`], write the manifest and swap the bake into place.
 
+pub mod estimate;
 pub mod plan;
 pub mod stages;
 pub mod workspace;
 
-pub use plan::{plan, Plan, PlanState, PlannedStage};
+pub use estimate::{PlanState, PlannedStage};
+pub use plan::{plan, Plan};
 
 use crate::baked::{self, manifest::hash_file, BakeTransaction, FileRecord, Manifest, StageRecord};
 use crate::error::{Error, Result};

@@ -2,6 +2,7 @@
 //! size, computed from the loaded input without writing anything. `run` checks the same estimate
 //! against `--max-memory` before it allocates.
 
+use super::estimate::{PlanState, PlannedStage};
 use super::stages::runner;
 use crate::load::LoadedInput;
 use crate::pipeline::{Pipeline, Stage};
@@ -19,33 +20,6 @@ pub struct Plan {
     pub peak_bytes: u64,
     /// Total size of the baked directory.
     pub output_bytes: u64,
-}
-
-/// One stage of a [`Plan`].
-#[derive(Clone, Debug, Serialize)]
-pub struct PlannedStage {
-    pub stage: String,
-    /// Estimated peak memory of the stage, in bytes, including what it keeps from earlier stages.
-    pub peak_bytes: u64,
-    /// Estimated bytes the stage writes.
-    pub output_bytes: u64,
-    /// What the estimate is based on.
-    pub notes: String,
-}
-
-/// Sizes that later stages' estimates depend on, updated stage by stage.
-#[derive(Clone, Debug, Default)]
-pub struct PlanState {
-    /// Bytes held in memory from earlier stages that later stages keep using.
-    pub resident_bytes: u64,
-    /// Triangles of a scene input.
-    pub triangles: u64,
-    /// Width and height of a height-map input.
-    pub map_size: (u64, u64),
-    /// Estimated patch count after voxelisation.
-    pub patches: u64,
-    /// Colour channels the transport needs (1 for grey scenes, 3 otherwise).
-    pub channels: u64,
 }
 
 impl Plan {

@@ -100,24 +100,4 @@ mod tests {
             );
         }
     }
-
-    #[test]
-    fn bc6h_round_trips_half_floats() {
-        let mut rgba = vec![0u8; 16 * 8];
-        for t in 0..16 {
-            for c in 0..3 {
-                let v = half::f16::from_f32(0.01 * (1.0 + 0.02 * t as f32) * (c + 1) as f32);
-                rgba[t * 8 + 2 * c..t * 8 + 2 * c + 2].copy_from_slice(&v.to_le_bytes());
-            }
-        }
-        let mut blk = [0u8; 16];
-        bc6h_encode_strip(&rgba, 4, &mut blk);
-        let d = bc6h_decode_block(&blk);
-        for t in 0..16 {
-            for c in 0..3 {
-                let want = 0.01 * (1.0 + 0.02 * t as f32) * (c + 1) as f32;
-                assert!((d[t][c] - want).abs() / want < 0.02, "{t} {c}: {}", d[t][c]);
-            }
-        }
-    }
 }

@@ -75,6 +75,15 @@ pub struct Transport {
     pub spectral_bounds: Vec<(f64, f64)>,
 }
 
+/// A transport is its matrix plus how it was computed: `t.channels`, `t.apply(..)` read the
+/// matrix.
+impl std::ops::Deref for Transport {
+    type Target = TransportMatrix;
+    fn deref(&self) -> &TransportMatrix {
+        &self.matrix
+    }
+}
+
 /// Estimated peak bytes of [`transport`]: the form factors, the output, and the working
 /// matrices of one channel (finite and Auto: up to four f32 matrices — M, S, M^j or the newest
 /// bounce, scratch; infinite: the f64 LU factor and solution plus M and S in f32).

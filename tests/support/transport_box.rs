@@ -9,7 +9,7 @@
 //! [`transport_or_env`] then reads it with `relume::baked::read_npy_f32`.
 #![allow(dead_code)]
 
-use relume::compress::TransportMatrix;
+use relume::radiosity::TransportMatrix;
 
 /// Patch geometry of the box.
 pub struct BoxScene {
@@ -147,7 +147,7 @@ pub fn transport(s: &BoxScene, bounces: Option<usize>) -> TransportMatrix {
 /// takes a while), or the matrix named by `RELUME_TRANSPORT_NPY` when that is set.
 pub fn transport_or_env(k: usize, bounces: Option<usize>) -> TransportMatrix {
     if let Ok(p) = std::env::var("RELUME_TRANSPORT_NPY") {
-        return TransportMatrix::read_npy(std::path::Path::new(&p)).expect("RELUME_TRANSPORT_NPY");
+        return relume::baked::transport::read_file(std::path::Path::new(&p)).expect("RELUME_TRANSPORT_NPY");
     }
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/relume-test-cache");
     let name = format!(
@@ -155,13 +155,13 @@ pub fn transport_or_env(k: usize, bounces: Option<usize>) -> TransportMatrix {
         bounces.map(|b| b.to_string()).unwrap_or("inf".into())
     );
     let path = dir.join(name);
-    if let Ok(m) = TransportMatrix::read_npy(&path) {
+    if let Ok(m) = relume::baked::transport::read_file(&path) {
         return m;
     }
     let m = transport(&closed_box(k, 7), bounces);
     let _ = std::fs::create_dir_all(&dir);
     let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    if m.write_npy(&tmp).is_ok() {
+    if relume::baked::transport::write_file(&tmp, &m).is_ok() {
         let _ = std::fs::rename(&tmp, &path);
     }
     m

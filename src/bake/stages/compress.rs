@@ -1,7 +1,7 @@
 //! The compression stages: `reorder` and `encode`.
 
 use super::{record, StageRun};
-use crate::bake::plan::{PlanState, PlannedStage};
+use crate::bake::estimate::{PlanState, PlannedStage};
 use crate::bake::workspace::Workspace;
 use crate::baked::{self, BakeTransaction, StageRecord};
 use crate::compress::dense::DenseEncoding;

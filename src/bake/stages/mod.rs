@@ -6,7 +6,7 @@ mod compress;
 mod radiosity;
 mod terrain;
 
-use super::plan::{PlanState, PlannedStage};
+use super::estimate::{PlanState, PlannedStage};
 use super::workspace::Workspace;
 use crate::baked::{BakeTransaction, StageRecord};
 use crate::error::Result;

@@ -1,7 +1,7 @@
 //! The radiosity stages: `voxelize`, `form_factors`, `transport`.
 
 use super::{record, StageRun};
-use crate::bake::plan::{PlanState, PlannedStage};
+use crate::bake::estimate::{PlanState, PlannedStage};
 use crate::bake::workspace::Workspace;
 use crate::baked::{self, form_factors::FormFactorMatrix, BakeTransaction, StageRecord};
 use crate::error::{Error, Result};

@@ -1,0 +1,31 @@
+//! What a stage's estimate says and what it passes on to the next stage's estimate.
+
+use serde::Serialize;
+
+/// One stage of a plan (`super::plan::Plan`).
+#[derive(Clone, Debug, Serialize)]
+pub struct PlannedStage {
+    pub stage: String,
+    /// Estimated peak memory of the stage, in bytes, including what it keeps from earlier stages.
+    pub peak_bytes: u64,
+    /// Estimated bytes the stage writes.
+    pub output_bytes: u64,
+    /// What the estimate is based on.
+    pub notes: String,
+}
+
+/// Sizes that later stages' estimates depend on, updated stage by stage.
+#[derive(Clone, Debug, Default)]
+pub struct PlanState {
+    /// Bytes held in memory from earlier stages that later stages keep using.
+    pub resident_bytes: u64,
+    /// Triangles of a scene input.
+    pub triangles: u64,
+    /// Width and height of a height-map input.
+    pub map_size: (u64, u64),
+    /// Estimated patch count after voxelisation.
+    pub patches: u64,
+    /// Colour channels the transport needs (1 for grey scenes, 3 otherwise).
+    pub channels: u64,
+}
+
