@@ -72,3 +72,12 @@ impl Blit {
         gpu.queue.submit([enc.finish()]);
     }
 }
+
+/// CPU twin of `blit.wgsl`: texel (x, y) of a `width`×`height` target is the source texel at
+/// (x, y) clamped to the source's last row and column (a plain copy when the sizes agree).
+pub fn blit_reference(source: &image::RgbaImage, width: u32, height: u32) -> image::RgbaImage {
+    let (sw, sh) = (source.width().max(1), source.height().max(1));
+    image::RgbaImage::from_fn(width, height, |x, y| {
+        *source.get_pixel(x.min(sw - 1), y.min(sh - 1))
+    })
+}

@@ -31,19 +31,21 @@ impl DecodePath {
     }
 }
 
+/// The `GatherParams` uniform of `gather_compressed.wgsl` (public for the layout test in
+/// tests/gpu_twins.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Params {
-    n: u32,
-    padded: u32,
-    channels: u32,
-    encoding: u32,
-    hardware: u32,
-    layer_words: u32,
-    log_range: f32,
-    pad: u32,
-    scale: [f32; 4],
-    lut: [[f32; 4]; 192],
+pub struct Params {
+    pub n: u32,
+    pub padded: u32,
+    pub channels: u32,
+    pub encoding: u32,
+    pub hardware: u32,
+    pub layer_words: u32,
+    pub log_range: f32,
+    pub pad: u32,
+    pub scale: [f32; 4],
+    pub lut: [[f32; 4]; 192],
 }
 
 /// GPU state of the compressed gather.

@@ -23,15 +23,16 @@ pub struct LightsUniform {
     pub layer_view_proj: [[f32; 16]; MAX_SHADOW_LAYERS],
 }
 
+/// The `Frame` uniform of `mesh_shade.wgsl` (public for the layout test in tests/gpu_twins.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct FrameUniform {
-    view_proj: [f32; 16],
-    eye: [f32; 4],
-    exposure: f32,
-    emission_scale: f32,
-    flags: u32,
-    pad: u32,
+pub struct FrameUniform {
+    pub view_proj: [f32; 16],
+    pub eye: [f32; 4],
+    pub exposure: f32,
+    pub emission_scale: f32,
+    pub flags: u32,
+    pub pad: u32,
 }
 
 /// GPU state for drawing one mesh scene.

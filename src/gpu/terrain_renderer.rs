@@ -13,48 +13,52 @@ use crate::terrain::MinMaxMipmap;
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
+/// The `TerrainParams` uniform of `terrain_shadow.wgsl` (public for the layout test in
+/// tests/gpu_twins.rs).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct TerrainParams {
-    width: u32,
-    height: u32,
-    levels: u32,
-    kind: u32,
-    step_x: i32,
-    step_y: i32,
-    pad0: [u32; 2],
-    ux: f32,
-    uy: f32,
-    inv_ux: f32,
-    inv_uy: f32,
-    rise_per_t: f32,
-    max_height: f32,
-    min_height: f32,
-    metres_per_t: f32,
-    alpha: f32,
-    planet_radius: f32,
-    sin_elevation0: f32,
-    cos_elevation0: f32,
-    sin_azimuth: f32,
-    cos_azimuth: f32,
-    cell_x: f32,
-    cell_y: f32,
-    tan_alpha: f32,
-    pad1: [u32; 3],
+pub struct TerrainParams {
+    pub width: u32,
+    pub height: u32,
+    pub levels: u32,
+    pub kind: u32,
+    pub step_x: i32,
+    pub step_y: i32,
+    pub pad0: [u32; 2],
+    pub ux: f32,
+    pub uy: f32,
+    pub inv_ux: f32,
+    pub inv_uy: f32,
+    pub rise_per_t: f32,
+    pub max_height: f32,
+    pub min_height: f32,
+    pub metres_per_t: f32,
+    pub alpha: f32,
+    pub planet_radius: f32,
+    pub sin_elevation0: f32,
+    pub cos_elevation0: f32,
+    pub sin_azimuth: f32,
+    pub cos_azimuth: f32,
+    pub cell_x: f32,
+    pub cell_y: f32,
+    pub tan_alpha: f32,
+    pub pad1: [u32; 3],
 }
 
+/// The `TerrainFrame` uniform of `terrain_render.wgsl` (public for the layout test in
+/// tests/gpu_twins.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct TerrainFrame {
-    view_proj: [f32; 16],
-    eye: [f32; 4],
-    sun: [f32; 4],
-    cell: [f32; 4],
-    fog: [f32; 4],
-    exposure: f32,
-    flags: u32,
-    min_height: f32,
-    max_height_tint: f32,
+pub struct TerrainFrame {
+    pub view_proj: [f32; 16],
+    pub eye: [f32; 4],
+    pub sun: [f32; 4],
+    pub cell: [f32; 4],
+    pub fog: [f32; 4],
+    pub exposure: f32,
+    pub flags: u32,
+    pub min_height: f32,
+    pub max_height_tint: f32,
 }
 
 /// GPU state for one height map.

@@ -172,3 +172,66 @@ pub fn point_face(v: Vec3) -> u32 {
         5
     }
 }
+
+/// One texel of [`shadow_depth`]: the depth the shadow pass stores, and the distance (texels)
+/// from the texel's centre to the nearest projected triangle edge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthTexel {
+    pub depth: f32,
+    pub edge_distance: f32,
+}
+
+/// Twin of the shadow-map pass (`shaders/shadow_depth.wgsl` with depth test `Less`, cleared to
+/// 1): the depth of the nearest of `triangles` (world space, both faces) at each texel centre of
+/// a `size`×`size` layer projected by `view_proj`, rows from the top. The depth is clip z / w,
+/// interpolated linearly in window space as the rasteriser does. No clipping: every corner must
+/// lie in front of the light with depth in [0, 1] (panics otherwise).
+pub fn shadow_depth(triangles: &[[Vec3; 3]], view_proj: Mat4, size: u32) -> Vec<DepthTexel> {
+    let s = size as f32;
+    let window: Vec<[Vec3; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.map(|p| {
+                let c = view_proj * p.extend(1.0);
+                assert!(c.w > 0.0, "corner {p} is behind the light");
+                let n = c.truncate() / c.w;
+                assert!((0.0..=1.0).contains(&n.z), "corner {p} has depth {}", n.z);
+                Vec3::new((n.x * 0.5 + 0.5) * s, (0.5 - n.y * 0.5) * s, n.z)
+            })
+        })
+        .collect();
+    let segment_distance = |p: glam::Vec2, a: glam::Vec2, b: glam::Vec2| {
+        let ab = b - a;
+        let t = ((p - a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+        (p - (a + ab * t)).length()
+    };
+    let mut out = Vec::with_capacity((size * size) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let p = glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let mut texel = DepthTexel {
+                depth: 1.0,
+                edge_distance: f32::INFINITY,
+            };
+            for [a, b, c] in &window {
+                let (a2, b2, c2) = (a.truncate(), b.truncate(), c.truncate());
+                for (u, v) in [(a2, b2), (b2, c2), (c2, a2)] {
+                    texel.edge_distance = texel.edge_distance.min(segment_distance(p, u, v));
+                }
+                let area = (b2 - a2).perp_dot(c2 - a2);
+                if area == 0.0 {
+                    continue;
+                }
+                let wa = (c2 - b2).perp_dot(p - b2) / area;
+                let wb = (a2 - c2).perp_dot(p - c2) / area;
+                let wc = 1.0 - wa - wb;
+                if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
+                    let z = wa * a.z + wb * b.z + wc * c.z;
+                    texel.depth = texel.depth.min(z);
+                }
+            }
+            out.push(texel);
+        }
+    }
+    out
+}
