@@ -84,7 +84,7 @@ lint:
 bench: build
 	$(CARGO) bench --locked
 
-## Speed/accuracy sweeps (DESIGN.md §7, docs/study.md): study.json, study.md and PNG plots in
+## Speed/accuracy sweeps (docs/algorithms.md §7, docs/study.md): study.json, study.md and PNG plots in
 ## out/study/{radiosity,compression,terrain}/. Add QUICK=1 for the small sizes (seconds).
 study: build
 	$(BAKE) study radiosity $(if $(QUICK),--quick) --out out/study/radiosity

@@ -1,5 +1,5 @@
 //! intel_tex_2 ships prebuilt ISPC kernels compiled as C++; with Rust's default linker they need
-//! libstdc++ linked explicitly (see docs/building.md).
+//! libstdc++ linked explicitly (see docs/dependencies.md).
 fn main() {
     let target = std::env::var("TARGET").unwrap_or_default();
     if target.contains("linux") {

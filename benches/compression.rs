@@ -78,7 +78,7 @@ fn main() {
     );
     let light_names: Vec<&str> = ctx.lights.iter().map(|l| l.0.as_str()).collect();
 
-    // 1. The seed's table: passes 0/1/2.
+    // 1. The radiosity thesis's table (its §4.2): passes 0/1/2.
     println!("## Reordering (Bc1Log, p = 4 %)\n");
     println!("| passes | metric | mean abs error | max abs error | summed abs error | gather RMS rel ({}) | reorder time |", light_names.join(" / "));
     println!("|---|---|---|---|---|---|---|");
@@ -112,7 +112,7 @@ fn main() {
 
     // 2. Error vs p.
     let candidates: Vec<(&str, EncodeOptions)> = vec![
-        ("Bc1Log (seed)", EncodeOptions::default()),
+        ("Bc1Log (thesis)", EncodeOptions::default()),
         (
             "Bc1Log + fill + feedback",
             EncodeOptions {
@@ -167,11 +167,11 @@ fn main() {
     });
     println!("\n## Encodings (2 passes Log metric, unless noted)\n");
     println!(
-        "Dense f32 mat-vec: {:.1} ms (median of 5). Seed scheme (Bc1Log, p = 4 %, 2 Linear passes): {} bytes.\n",
+        "Dense f32 mat-vec: {:.1} ms (median of 5). Thesis scheme (Bc1Log, p = 4 %, 2 Linear passes): {} bytes.\n",
         1e3 * dense_secs,
         seed.bytes()
     );
-    println!("| encoding | p | fill | feedback | summed abs error | gather RMS rel ({}) | worst | dense bytes | sidecar bytes | total / seed | gather time / dense mat-vec |", light_names.join(" / "));
+    println!("| encoding | p | fill | feedback | summed abs error | gather RMS rel ({}) | worst | dense bytes | sidecar bytes | total / thesis | gather time / dense mat-vec |", light_names.join(" / "));
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let mut rows: Vec<(String, f64, EncodeOptions, bool)> = Vec::new();
     for enc in DenseEncoding::ALL {
@@ -195,7 +195,7 @@ fn main() {
         }
     }
     rows.push((
-        "bc1_log (seed, Linear passes)".into(),
+        "bc1_log (thesis, Linear passes)".into(),
         4.0,
         EncodeOptions::default(),
         true,

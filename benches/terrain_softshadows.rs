@@ -1,6 +1,6 @@
 //! Soft shadows on Puget Sound at 1K, 2K and 4K (box-downsampled from the 4K file), sun
 //! elevations 2°, 5°, 10°: time and error of uniform stepping (16/32/64/100/256 steps), the
-//! seed's dynamic programming at several start levels, and branch-and-bound, against the
+//! soft-shadow paper's dynamic programming at several start levels, and branch-and-bound, against the
 //! exhaustive reference. Time is CPU time as a ratio against uniform-100 in the same run;
 //! errors are the mean and max absolute lit fraction. Prints a Markdown table.
 //!

@@ -101,7 +101,7 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
     }
     var rgb = texel_radiance(height_at(col, row), lambert_at(col, row), shadow, frame.sun.w);
     if ((frame.flags & 2u) != 0u) {
-        // Aerial perspective (seed 001): L = L0·e^(−β s) + E_sun·(β_sc/β_ext)·Φ(θ)·(1 − e^(−β s)).
+        // Aerial perspective (docs/algorithms.md §6): L = L0·e^(−β s) + E_sun·(β_sc/β_ext)·Φ(θ)·(1 − e^(−β s)).
         let to_eye = frame.eye.xyz - v.world;
         let s = length(to_eye);
         let view = -to_eye / max(s, 1e-6);

@@ -308,7 +308,7 @@ fn bad_encode_knobs_and_missing_transport_are_errors() {
 #[test]
 fn default_encode_meets_the_goal_on_the_box() {
     // Issue 4's goal: ≤ 2 % RMS relative error of the gathered light at ≤ 1.5x the bytes of the
-    // seed's scheme (Bc1Log, p = 4 %), here on the small box and the standard lights.
+    // radiosity thesis's scheme (Bc1Log, p = 4 %), here on the small box and the standard lights.
     let tmp = tempfile::tempdir().unwrap();
     let s = transport_box::transport(&transport_box::closed_box(8, 2), None); // n = 384
     let dir = bake_with_transport(tmp.path(), "b", &s);
@@ -328,7 +328,7 @@ fn default_encode_meets_the_goal_on_the_box() {
     .unwrap();
     assert!(
         enc.bytes() as f64 <= 1.5 * seed.bytes() as f64,
-        "{} vs seed {}",
+        "{} vs the thesis's scheme {}",
         enc.bytes(),
         seed.bytes()
     );
@@ -345,7 +345,7 @@ fn default_encode_meets_the_goal_on_the_box() {
 #[test]
 fn two_reorder_passes_do_not_increase_the_summed_error_on_the_cornell_box() {
     // The real Cornell box bake (pipelines/cornell.ron: voxelize → form factors → transport),
-    // then the seed's scheme (Bc1Log, p = 4 %) after 0, 1 and 2 reorder passes.
+    // then the radiosity thesis's scheme (Bc1Log, p = 4 %) after 0, 1 and 2 reorder passes.
     use relume::compress::{reorder, ReorderMetric, ReorderOptions};
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("cornell");

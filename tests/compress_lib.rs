@@ -157,7 +157,7 @@ fn one_huge_entry_among_tiny_ones() {
     let e0 = compress(&s, identity(n), 0.0, &opts(DenseEncoding::Bc4Log)).unwrap();
     let r0 = report::entry_errors(&s, &e0);
     assert!(r0.max <= 1e6 * 0.06, "{r0:?}");
-    // ...with the smallest split the huge entry is exact (seed: zeroed in the dense part)...
+    // ...with the smallest split the huge entry is exact (zeroed in the dense part, as in the radiosity thesis)...
     let e = compress(&s, identity(n), 0.1, &opts(DenseEncoding::Bc4Log)).unwrap();
     assert_eq!(e.sidecar.nnz(), 1);
     assert_eq!(e.sidecar.values[0], 1e6);

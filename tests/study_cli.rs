@@ -200,7 +200,7 @@ fn compression_quick_sweeps_reorder_split_and_encodings() {
         ]
     );
     for s in settings(r) {
-        // The seed's three numbers are all there.
+        // The radiosity thesis's three numbers are all there.
         for m in ["mean", "max", "sum"] {
             assert!(err(s, "matrix", m) > 0.0);
         }

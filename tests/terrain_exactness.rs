@@ -1,7 +1,7 @@
 //! Hard shadows: the accelerated traversal (A2 over the min/max mipmap) equals the exact
 //! traversal (A1) on every pixel — on random maps of every small size with plateaus, cliffs and
 //! spikes and random suns including exactly axis-aligned ones, 1e-12 off an axis, 45°,
-//! elevations just above 0 and near 90°; and on the seed's stress maps. Also: the mipmap's
+//! elevations just above 0 and near 90°; and on the relief-shadow paper's stress maps. Also: the mipmap's
 //! bounds cover every sample the exact traversal can take in a block.
 
 mod terrain_common;
