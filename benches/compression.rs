@@ -11,7 +11,10 @@
 mod transport_box;
 
 use relume::compress::report::{self, rms_relative, standard_lights};
-use relume::compress::{compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric, ReorderOptions};
+use relume::compress::{
+    compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric,
+    ReorderOptions,
+};
 use relume::radiosity::TransportMatrix;
 use relume::study::timing::median_secs;
 use std::time::Instant;

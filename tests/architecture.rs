@@ -254,7 +254,12 @@ fn resolve(tree: &Tree, from: &[String], path: &[String]) -> Option<Vec<String>>
     follow(tree, module, segs, 0)
 }
 
-fn follow(tree: &Tree, mut module: Vec<String>, segs: &[String], depth: u32) -> Option<Vec<String>> {
+fn follow(
+    tree: &Tree,
+    mut module: Vec<String>,
+    segs: &[String],
+    depth: u32,
+) -> Option<Vec<String>> {
     if depth > 16 {
         return Some(module);
     }
@@ -464,7 +469,10 @@ fn the_checker_catches_an_import_from_a_layer_above() {
     let tree = fixture(&[
         ("", "pub mod app; pub mod algo; pub mod base;"),
         ("app", "use crate::algo::run;\n"),
-        ("algo", "pub fn run() {}\n// crate::app::x in a comment is no import\n"),
+        (
+            "algo",
+            "pub fn run() {}\n// crate::app::x in a comment is no import\n",
+        ),
         ("base", "pub fn f() { crate::app::helper(); }\n"),
     ]);
     let f = check(&tree, &layers_from_doc(FIXTURE_LAYERS));
@@ -477,7 +485,10 @@ fn the_checker_catches_an_import_from_a_layer_above() {
 fn the_checker_catches_a_cycle_between_files_and_follows_reexports() {
     let tree = fixture(&[
         ("", "pub mod algo;"),
-        ("algo", "pub mod a; pub mod b; pub mod c;\npub use c::Thing;\n"),
+        (
+            "algo",
+            "pub mod a; pub mod b; pub mod c;\npub use c::Thing;\n",
+        ),
         ("algo/a", "use super::b::{B, other::{X}};\n"),
         ("algo/b", "use crate::algo::Thing; // re-exported from c\n"),
         ("algo/c", "pub struct Thing; fn f() { super::a::g(); }\n"),
@@ -495,7 +506,10 @@ fn the_checker_catches_a_cycle_between_files_and_follows_reexports() {
     // Without the back edge there is no cycle: the mod.rs re-export is not an edge.
     let tree = fixture(&[
         ("", "pub mod algo;"),
-        ("algo", "pub mod a; pub mod b; pub mod c;\npub use c::Thing;\n"),
+        (
+            "algo",
+            "pub mod a; pub mod b; pub mod c;\npub use c::Thing;\n",
+        ),
         ("algo/a", "use super::b::B;\n"),
         ("algo/b", "use crate::algo::Thing;\n"),
         ("algo/c", "pub struct Thing;\n"),

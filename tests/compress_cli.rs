@@ -7,8 +7,8 @@ mod common;
 mod transport_box;
 
 use common::{bake, expect_code, python, python_with, text};
-use relume::baked::{manifest::hash_file, FileRecord, Manifest};
 use relume::baked::encoded::read as read_encoded;
+use relume::baked::{manifest::hash_file, FileRecord, Manifest};
 use relume::compress::{bc1, compress, gather, report, DenseEncoding, EncodeOptions};
 use relume::radiosity::TransportMatrix;
 use std::path::{Path, PathBuf};

@@ -6,9 +6,12 @@ mod transport_box;
 
 use proptest::prelude::*;
 use relume::compress::report::{self, rms_relative, standard_lights};
-use relume::compress::{compress, gather, reorder, split_top, DenseEncoding, EncodeOptions, ReorderMetric, ReorderOptions, Sidecar};
+use relume::compress::{
+    compress, gather, reorder, split_top, DenseEncoding, EncodeOptions, ReorderMetric,
+    ReorderOptions, Sidecar,
+};
+use relume::radiosity::matrix::is_permutation;
 use relume::radiosity::TransportMatrix;
-use relume::radiosity::matrix::{is_permutation};
 
 fn opts(encoding: DenseEncoding) -> EncodeOptions {
     EncodeOptions {

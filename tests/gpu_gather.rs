@@ -6,10 +6,12 @@ mod common;
 
 use common::{bake, data, expect_code, gpu};
 use relume::baked::encoded::read as read_encoded;
-use relume::compress::{compress, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderOptions};
-use relume::radiosity::TransportMatrix;
+use relume::compress::{
+    compress, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderOptions,
+};
 use relume::gpu::compressed_gather::{CompressedGather, DecodePath};
 use relume::gpu::{compute, readback, timing::PassTimer, Gpu};
+use relume::radiosity::TransportMatrix;
 
 /// A deterministic, uneven light: E per channel in [0, 1), some patches dark.
 fn light(n: usize) -> Vec<[f32; 3]> {

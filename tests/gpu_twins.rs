@@ -11,7 +11,7 @@ use common::gpu;
 use glam::{DVec3, Mat4, Vec3, Vec4};
 use rand_core::{RngCore, SeedableRng};
 use relume::gpu::mesh_renderer::{LightsUniform, MeshRenderer};
-use relume::gpu::radiosity_runtime::{DenseTransport, RadiosityRuntime, TransportSource};
+use relume::gpu::radiosity_runtime::{RadiosityRuntime, TransportSource};
 use relume::gpu::{compute, readback, shader_source, Gpu};
 use relume::render::lights::{
     light_irradiance, point_face, shadow_depth, shadow_projections, GpuLight, KIND_DIRECTIONAL,
@@ -966,7 +966,7 @@ fn light_end(l: &GpuLight, p: Vec3) -> Vec3 {
 #[test]
 fn direct_light_kernel_with_punctual_lights_and_shadow_maps_matches_its_twin() {
     use relume::radiosity::fixtures::SceneBuilder;
-    use relume::radiosity::patches::{voxelize, Resolution, VoxelizeParams};
+    use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
     use relume::render::direct::patch_exitance;
     let Some(gpu) = gpu() else { return };
     // A floor and a floating square above it.
@@ -992,15 +992,11 @@ fn direct_light_kernel_with_punctual_lights_and_shadow_maps_matches_its_twin() {
     .unwrap();
     let n = set.patches.len();
     let mut renderer = MeshRenderer::new(&gpu, &scene, 8, 8, 1024).unwrap();
-    let zeros = vec![0.0f32; n * n];
+    let zeros = relume::radiosity::TransportMatrix::zeros(1, n);
     let rt = RadiosityRuntime::new(
         &gpu,
         &set,
-        TransportSource::Dense(DenseTransport {
-            channels: 1,
-            n,
-            data: &zeros,
-        }),
+        TransportSource::Dense(&zeros),
         &renderer,
     )
     .unwrap();

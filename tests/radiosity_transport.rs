@@ -5,9 +5,9 @@ use proptest::prelude::*;
 use relume::progress::Silent;
 use relume::radiosity::fixtures;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::reference::gauss_seidel;
 use relume::radiosity::transport::{transport, Bounces, Power, Transport, TransportParams};
+use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 
 const BIG: u64 = 1 << 40;
@@ -106,10 +106,7 @@ fn one_bounce_is_m_and_more_bounces_converge_to_infinity() {
     for c in 0..3 {
         for i in 0..n {
             for j in 0..n {
-                assert_eq!(
-                    s1.data[c * n * n + i * n + j],
-                    albedo[i][c] * f[i * n + j]
-                );
+                assert_eq!(s1.data[c * n * n + i * n + j], albedo[i][c] * f[i * n + j]);
             }
         }
     }

@@ -5,13 +5,13 @@
 use glam::DVec3;
 use proptest::prelude::*;
 use relume::progress::Silent;
+use relume::radiosity::corners::interpolate;
 use relume::radiosity::fixtures::{self, SceneBuilder};
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
 use relume::radiosity::geometry::{self, dominant_axis};
 use relume::radiosity::overlap::{visible_parts, Face};
-use relume::radiosity::voxelize::{clip_to_voxels, voxelize, Resolution, VoxelizeParams};
-use relume::radiosity::corners::interpolate;
 use relume::radiosity::transport::{transport, Bounces, Power, TransportParams};
+use relume::radiosity::voxelize::{clip_to_voxels, voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::PatchSet;
 use relume::scene::Scene;
 

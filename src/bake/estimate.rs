@@ -28,4 +28,3 @@ pub struct PlanState {
     /// Colour channels the transport needs (1 for grey scenes, 3 otherwise).
     pub channels: u64,
 }
-

@@ -15,11 +15,11 @@ use crate::limits;
 use crate::load::{load_input, LoadedInput};
 use crate::pipeline::{Pipeline, Stage};
 use crate::progress::Progress;
-use stages::runner;
-use workspace::Workspace;
 use serde::Serialize;
+use stages::runner;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use workspace::Workspace;
 
 /// Knobs of a bake that are not part of the pipeline (they do not change the output).
 #[derive(Clone, Debug)]

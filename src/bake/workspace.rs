@@ -72,14 +72,70 @@ impl Workspace {
             .unwrap_or_else(crate::limits::default_max_memory)
     }
 
-    slot!(scene, set_scene, scene, Scene, baked::scene::FILE, |d: &Path, _: &Manifest| baked::scene::read(d));
-    slot!(heightmap, set_heightmap, heightmap, HeightMap, baked::heightmap::FILE, baked::heightmap::read);
-    slot!(patches, set_patches, patches, PatchSet, baked::patches::FILE, |d: &Path, _: &Manifest| baked::patches::read(d));
-    slot!(form_factors, set_form_factors, form_factors, FormFactorMatrix, baked::form_factors::FILE, |d: &Path, _: &Manifest| baked::form_factors::read(d));
-    slot!(transport, set_transport, transport, TransportMatrix, baked::transport::FILE, |d: &Path, _: &Manifest| baked::transport::read(d));
-    slot!(permutation, set_permutation, permutation, Vec<u32>, baked::permutation::FILE, |d: &Path, _: &Manifest| baked::permutation::read(d));
-    slot!(encoded, set_encoded, encoded, EncodedTransport, baked::encoded::TRANSFER_FILE, |d: &Path, _: &Manifest| baked::encoded::read(d));
-    slot!(mipmap, set_mipmap, mipmap, MinMaxMipmap, baked::mipmap::FILE, |d: &Path, _: &Manifest| baked::mipmap::read(d));
+    slot!(
+        scene,
+        set_scene,
+        scene,
+        Scene,
+        baked::scene::FILE,
+        |d: &Path, _: &Manifest| baked::scene::read(d)
+    );
+    slot!(
+        heightmap,
+        set_heightmap,
+        heightmap,
+        HeightMap,
+        baked::heightmap::FILE,
+        baked::heightmap::read
+    );
+    slot!(
+        patches,
+        set_patches,
+        patches,
+        PatchSet,
+        baked::patches::FILE,
+        |d: &Path, _: &Manifest| baked::patches::read(d)
+    );
+    slot!(
+        form_factors,
+        set_form_factors,
+        form_factors,
+        FormFactorMatrix,
+        baked::form_factors::FILE,
+        |d: &Path, _: &Manifest| baked::form_factors::read(d)
+    );
+    slot!(
+        transport,
+        set_transport,
+        transport,
+        TransportMatrix,
+        baked::transport::FILE,
+        |d: &Path, _: &Manifest| baked::transport::read(d)
+    );
+    slot!(
+        permutation,
+        set_permutation,
+        permutation,
+        Vec<u32>,
+        baked::permutation::FILE,
+        |d: &Path, _: &Manifest| baked::permutation::read(d)
+    );
+    slot!(
+        encoded,
+        set_encoded,
+        encoded,
+        EncodedTransport,
+        baked::encoded::TRANSFER_FILE,
+        |d: &Path, _: &Manifest| baked::encoded::read(d)
+    );
+    slot!(
+        mipmap,
+        set_mipmap,
+        mipmap,
+        MinMaxMipmap,
+        baked::mipmap::FILE,
+        |d: &Path, _: &Manifest| baked::mipmap::read(d)
+    );
 
     /// Is there a permutation, made earlier in this run or in the source bake?
     pub fn has_permutation(&self) -> bool {

@@ -112,8 +112,15 @@ pub fn read(dir: &Path) -> Result<EncodedTransport> {
     for tile in &info.tiles {
         let path = dir.join(format!("{}.{}", tile.stem, container.extension()));
         let (w, h, layers) = match container {
-            Container::Dds => containers::parse_dds(&path, &std::fs::read(&path).at(&path, "cannot read")?, enc)?,
-            Container::Ktx2 => containers::parse_ktx2(&path, &std::fs::read(&path).at(&path, "cannot read")?, enc, nl)?,
+            Container::Dds => {
+                containers::parse_dds(&path, &std::fs::read(&path).at(&path, "cannot read")?, enc)?
+            }
+            Container::Ktx2 => containers::parse_ktx2(
+                &path,
+                &std::fs::read(&path).at(&path, "cannot read")?,
+                enc,
+                nl,
+            )?,
         };
         if (w, h) != (tile.cols, tile.rows) {
             return Err(Error::input(

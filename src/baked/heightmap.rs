@@ -28,10 +28,12 @@ pub fn read(dir: &Path, manifest: &Manifest) -> Result<HeightMap> {
         .stage("load")
         .ok_or_else(|| Error::input(dir.join(super::MANIFEST), "no `load` stage record"))?;
     let get = |k: &str| {
-        load.report
-            .get(k)
-            .copied()
-            .ok_or_else(|| Error::input(dir.join(super::MANIFEST), format!("`load` record lacks `{k}`")))
+        load.report.get(k).copied().ok_or_else(|| {
+            Error::input(
+                dir.join(super::MANIFEST),
+                format!("`load` record lacks `{k}`"),
+            )
+        })
     };
     let cell_size = [get("cell_size_x")?, get("cell_size_y")?];
     let height_scale = get("height_scale")?;
@@ -50,4 +52,3 @@ pub fn read(dir: &Path, manifest: &Manifest) -> Result<HeightMap> {
         height_scale,
     })
 }
-

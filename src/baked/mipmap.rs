@@ -78,9 +78,7 @@ pub fn read_file(path: &Path) -> Result<MinMaxMipmap> {
     let bad = |m: String| crate::error::Error::input(path, m);
     let first = image.layer_data.first().map(|l| &l.attributes.other);
     let (mw, mh) = match first.and_then(|o| o.get(&Text::from("relumeMapSize"))) {
-        Some(AttributeValue::IntVec2(Vec2(w, h))) if *w > 0 && *h > 0 => {
-            (*w as usize, *h as usize)
-        }
+        Some(AttributeValue::IntVec2(Vec2(w, h))) if *w > 0 && *h > 0 => (*w as usize, *h as usize),
         _ => {
             return Err(bad(
                 "not a relume min/max mipmap: no `relumeMapSize` attribute".into(),

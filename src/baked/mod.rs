@@ -42,4 +42,3 @@ pub fn read_postcard<T: DeserializeOwned>(path: &Path) -> Result<T> {
     let bytes = std::fs::read(path).at(path, "cannot read")?;
     postcard::from_bytes(&bytes).map_err(|e| Error::input(path, format!("corrupt record: {e}")))
 }
-

@@ -50,4 +50,3 @@ pub fn read_file(path: &Path) -> Result<Vec<u32>> {
     }
     Ok(perm)
 }
-

@@ -49,10 +49,5 @@ pub fn read_file(path: &Path) -> Result<TransportMatrix> {
 
 /// Write a `[channels, n, n]` f32 `.npy` file.
 pub fn write_file(path: &Path, m: &TransportMatrix) -> Result<()> {
-    npy::write_npy_f32(
-        path,
-        &[m.channels as u64, m.n as u64, m.n as u64],
-        &m.data,
-    )
+    npy::write_npy_f32(path, &[m.channels as u64, m.n as u64, m.n as u64], &m.data)
 }
-

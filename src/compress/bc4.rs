@@ -65,7 +65,6 @@ pub fn bc4_encode_strip(r8: &[u8], width: usize, dst: &mut [u8]) {
     intel_tex_2::bc4::compress_blocks_into(&surface, dst);
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

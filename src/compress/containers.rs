@@ -207,7 +207,11 @@ pub fn dds_bytes(
 }
 
 /// Parse a DDS tile: (width, height, layers). `path` names the file in errors.
-pub fn parse_dds(path: &Path, bytes: &[u8], enc: DenseEncoding) -> Result<(u32, u32, Vec<Vec<u8>>)> {
+pub fn parse_dds(
+    path: &Path,
+    bytes: &[u8],
+    enc: DenseEncoding,
+) -> Result<(u32, u32, Vec<Vec<u8>>)> {
     let dds =
         Dds::read(&bytes[..]).map_err(|e| Error::input(path, format!("not a DDS file: {e}")))?;
     let ok = match enc {

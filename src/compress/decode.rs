@@ -21,7 +21,6 @@ impl DenseTexture {
             luts: self.maps.iter().map(LogMap::lut).collect(),
         }
     }
-
 }
 
 impl Decoder<'_> {
@@ -119,4 +118,3 @@ pub fn decode_block_at(
         }
     }
 }
-

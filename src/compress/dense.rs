@@ -1,5 +1,5 @@
 //! The dense part as a texture: the encodings of the `encode` stage's `encoding` knob, their
-//! per-strip encoders and their per-block decoders (DESIGN.md §3 "Compression" steps 3–4).
+//! per-strip encoders and their per-block decoders (docs/algorithms.md §3 "Compression" steps 3–4).
 //!
 //! Layout: the matrix is padded with zeros to `padded = 4·⌈n/4⌉`. Block encodings store blocks
 //! in row-major block order (block (by, bx) covers rows 4by..4by+4, columns 4bx..4bx+4);
@@ -7,21 +7,21 @@
 //! the channels (a grey matrix repeats its one channel); per-channel encodings (BC4, F16, F32)
 //! have one layer per channel.
 //!
-//! Error feedback (`feedback: true`, beyond the seed): blocks of a block row are encoded left
+//! Error feedback (`feedback: true`, beyond the radiosity thesis): blocks of a block row are encoded left
 //! to right, and each row carries the running linear error `Σ (S − decoded)` of the blocks before
 //! it into the next block's target (spread over the block's entries in proportion to their
 //! values, at most doubling or halving any entry). Row sums — and so the gathered light for any
 //! light that varies slowly along the reordered columns — stay close to exact, while each entry
 //! keeps the encoding's own per-entry error.
 
-use crate::error::{Error, Result};
 use super::logmap::LogMap;
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// How the dense part is stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 pub enum DenseEncoding {
-    /// The seed's: 8-bit log codes of the three channels as one BC1 texel (0.5 byte/entry).
+    /// The radiosity thesis's: 8-bit log codes of the three channels as one BC1 texel (0.5 byte/entry).
     Bc1Log,
     /// 8-bit log codes, one BC4 texture layer per channel (0.5 byte/entry/channel).
     Bc4Log,
@@ -84,16 +84,16 @@ impl DenseEncoding {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EncodeOptions {
     pub encoding: DenseEncoding,
-    /// Natural-log range of the log mapping (the seed's 25).
+    /// Natural-log range of the log mapping (the radiosity thesis's 25).
     pub log_range: f32,
     /// Carry each row's running error into the next block (see the module doc).
     pub feedback: bool,
-    /// Instead of zeroing the sidecar's entries in the dense part (the seed), fill them like
+    /// Instead of zeroing the sidecar's entries in the dense part (the radiosity thesis), fill them like
     /// padding and store `S − decoded` in the sidecar (exact sum, tighter blocks).
     pub fill_holes: bool,
 }
 
-/// The seed's scheme (Bc1Log, range 25, no feedback, zeroed holes). The `encode` stage's
+/// The radiosity thesis's scheme (Bc1Log, range 25, no feedback, zeroed holes). The `encode` stage's
 /// defaults differ (see `stages::EncodeKnobs`).
 impl Default for EncodeOptions {
     fn default() -> Self {
@@ -158,4 +158,3 @@ impl DenseTexture {
         Ok(())
     }
 }
-

@@ -287,4 +287,3 @@ fn encode_row_feedback(
     }
     out
 }
-

@@ -1,4 +1,4 @@
-//! The CPU gather `B_ind = S · E` straight from the compressed form (DESIGN.md §2 "player":
+//! The CPU gather `B_ind = S · E` straight from the compressed form (docs/algorithms.md §2 "player":
 //! decode BC1 + add the sidecar), the reference the GPU player's gather is tested against.
 //!
 //! Steps: permute the light (`E'[k] = E[perm[k]]`); for each block row (4 output rows, in

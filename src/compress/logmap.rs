@@ -1,5 +1,5 @@
-//! The seed's log mapping of the dense part (seed 003 §4.2, DESIGN.md §3 "Compression" step 3):
-//! divide by the largest remaining value, take ln, add the range R (the seed's 25), scale [0, R]
+//! The radiosity thesis's log mapping of the dense part (its §4.2; docs/algorithms.md §3 "Compression" step 3):
+//! divide by the largest remaining value, take ln, add the range R (the thesis's 25), scale [0, R]
 //! to [0, 255]. Code 0 is reserved for exact zero: values at or below `scale · e^-R` (and zeros,
 //! negatives, NaN) encode to 0 and decode to exactly 0.0; every other value gets a code in
 //! 1..=255.
@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The seed's range: values below e^-25 of the largest are dropped.
+/// The radiosity thesis's range: values below e^-25 of the largest are dropped.
 pub const SEED_RANGE: f32 = 25.0;
 
 /// One channel's log mapping.
@@ -23,7 +23,7 @@ pub struct LogMap {
 }
 
 impl LogMap {
-    /// The seed's mapping for a channel whose largest value is `scale`.
+    /// The radiosity thesis's mapping for a channel whose largest value is `scale`.
     pub fn seed(scale: f32) -> Self {
         LogMap {
             scale: if scale.is_finite() && scale > 0.0 {

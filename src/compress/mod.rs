@@ -1,4 +1,4 @@
-//! Transport compression: the seed's §4.2 (seed 003, DESIGN.md §3 "Compression") and what beats it.
+//! Transport compression: the radiosity thesis's §4.2 (docs/algorithms.md §3 "Compression") and what beats it.
 //!
 //! Data flow (every step a pure function over plain data):
 //!
@@ -9,7 +9,7 @@
 //!   ─▶ block texture (BC1 / BC4 / BC6H / F16 / F32)            [bc1.rs, blocks.rs, dense.rs]
 //!   ─▶ DDS / KTX2 files (tiled when wider than the max size)   [containers.rs]
 //! gather: B_ind = S · E straight from the compressed form      [gather.rs]
-//! report: the seed's three errors, RMS relative error of B_ind [report.rs]
+//! report: the thesis's three errors, RMS relative error of B_ind [report.rs]
 //! ```
 //!
 //! Index convention: `perm[k]` is the original patch index placed at position `k`, so

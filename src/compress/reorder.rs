@@ -1,15 +1,15 @@
-//! Greedy reordering of a transport matrix (seed 003 §4.2, DESIGN.md §3 "Compression" step 1).
+//! Greedy reordering of a transport matrix (the radiosity thesis §4.2; docs/algorithms.md §3 "Compression" step 1).
 //!
 //! One pass: compare every pair of rows (or columns) by the sum of absolute differences over all
 //! channels; start at position 0 and repeatedly place the most similar remaining row next (ties:
-//! the lowest index). The seed runs a rows pass, then a columns pass on the result. Each pass's
+//! the lowest index). The radiosity thesis runs a rows pass, then a columns pass on the result. Each pass's
 //! order is applied to rows and columns together (`S' = P S Pᵀ`), so `B' = S' E'` stays exact.
 //!
 //! Cost: a pass computes all n²/2 pairwise distances of vectors of length `channels·n`
 //! (O(channels·n³), blocked for cache, parallel over tiles), then an O(n²) greedy walk. Memory:
 //! an n×n f32 distance matrix plus one copy of S.
 //!
-//! Beyond the seed, [`ReorderMetric::Log`] compares the log-mapped 8-bit codes (the values the
+//! Beyond the thesis, [`ReorderMetric::Log`] compares the log-mapped 8-bit codes (the values the
 //! block encoder actually compresses) instead of the raw values, which are dominated by the few
 //! large entries that the split removes anyway.
 
@@ -19,12 +19,14 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// What the greedy pass compares.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
+)]
 pub enum ReorderMetric {
-    /// The seed's: sum of absolute differences of the raw values.
+    /// The radiosity thesis's: sum of absolute differences of the raw values.
     #[default]
     Linear,
-    /// Sum of absolute differences of the seed's 8-bit log codes (per-channel scale = the
+    /// Sum of absolute differences of the radiosity thesis's 8-bit log codes (per-channel scale = the
     /// channel's largest entry, range e^-25).
     Log,
 }
@@ -174,7 +176,7 @@ fn l1(a: &[f32], b: &[f32]) -> f32 {
     ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + s
 }
 
-/// The seed's walk: start at 0, repeatedly go to the nearest unvisited vector (ties: lowest
+/// The radiosity thesis's walk: start at 0, repeatedly go to the nearest unvisited vector (ties: lowest
 /// index).
 fn greedy_walk(dist: &[f32], n: usize) -> Vec<u32> {
     let mut used = vec![false; n];

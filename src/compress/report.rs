@@ -1,4 +1,4 @@
-//! The compression error report (DESIGN.md §3 "Compression" step 5): the seed's three numbers
+//! The compression error report (docs/algorithms.md §3 "Compression" step 5): the radiosity thesis's three numbers
 //! — mean, max and summed absolute error of the decoded matrix against the uncompressed S —
 //! plus the RMS relative error of the gathered indirect light for a few deterministic light
 //! configurations, and the bytes of the dense part and the sidecar.

@@ -1,4 +1,4 @@
-//! The split (seed 003 §4.2, DESIGN.md §3 "Compression" step 2): the largest p % of the entries
+//! The split (the radiosity thesis §4.2; docs/algorithms.md §3 "Compression" step 2): the largest p % of the entries
 //! go to a sparse sidecar at full precision and are zeroed in the dense part.
 //!
 //! An entry is a texel (i, j) with all its channels; its magnitude is the largest absolute value
@@ -6,8 +6,8 @@
 //! index `i·n + j`, so the selection is deterministic. The sidecar is CSR over rows of the
 //! (permuted) matrix; its binary layout is in docs/baked-format.md (`sidecar.bin`).
 
-use crate::radiosity::TransportMatrix;
 use crate::error::{Error, Result};
+use crate::radiosity::TransportMatrix;
 use rayon::prelude::*;
 use std::path::Path;
 

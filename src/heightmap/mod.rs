@@ -257,7 +257,7 @@ impl HeightMap {
     }
 
     /// Bilinear height at texel-space position (px, py) — texel centres at half-integers,
-    /// clamped at the border (DESIGN.md §4).
+    /// clamped at the border (docs/algorithms.md §4).
     pub fn bilinear(&self, px: f64, py: f64) -> f64 {
         let fx = (px - 0.5).clamp(0.0, (self.width - 1) as f64);
         let fy = (py - 0.5).clamp(0.0, (self.height - 1) as f64);

@@ -15,7 +15,9 @@ pub fn positive_f32(v: f32) -> Result<f32, String> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(format!("out of range: {v} (must be a positive finite number)"))
+        Err(format!(
+            "out of range: {v} (must be a positive finite number)"
+        ))
     }
 }
 
@@ -24,7 +26,9 @@ pub fn positive_f64(v: f64) -> Result<f64, String> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(format!("out of range: {v} (must be a positive finite number)"))
+        Err(format!(
+            "out of range: {v} (must be a positive finite number)"
+        ))
     }
 }
 
@@ -195,9 +199,7 @@ pub mod de {
     pub fn positive_f32<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
         with(d, super::positive_f32)
     }
-    pub fn optional_positive_f64<'de, D: Deserializer<'de>>(
-        d: D,
-    ) -> Result<Option<f64>, D::Error> {
+    pub fn optional_positive_f64<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
         optional(d, super::positive_f64)
     }
     pub fn optional_cell_size<'de, D: Deserializer<'de>>(
@@ -208,9 +210,7 @@ pub mod de {
     pub fn at_least_one<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
         with(d, super::at_least_one)
     }
-    pub fn optional_at_least_one<'de, D: Deserializer<'de>>(
-        d: D,
-    ) -> Result<Option<u32>, D::Error> {
+    pub fn optional_at_least_one<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
         optional(d, super::at_least_one)
     }
     pub fn percent<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {

@@ -17,7 +17,10 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct VoxelizeKnobs {
     /// `TargetPatches(n)` (the stage picks the voxel size) or `VoxelSize(s)` in scene units.
-    #[serde(default = "default_resolution", deserialize_with = "checks::de::resolution")]
+    #[serde(
+        default = "default_resolution",
+        deserialize_with = "checks::de::resolution"
+    )]
     pub resolution: Resolution,
     /// Points per patch stored for the runtime's direct light.
     #[serde(
@@ -103,13 +106,13 @@ fn default_bounces() -> Bounces {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReorderKnobs {
-    /// Greedy passes: 0 (identity), 1 (rows), 2 (rows then columns, the seed's).
+    /// Greedy passes: 0 (identity), 1 (rows), 2 (rows then columns, the radiosity thesis's).
     #[serde(
         default = "default_passes",
         deserialize_with = "checks::de::reorder_passes"
     )]
     pub passes: u8,
-    /// `Linear` (the seed's: raw values, default) or `Log` (the 8-bit log codes the encoder
+    /// `Linear` (the radiosity thesis's: raw values, default) or `Log` (the 8-bit log codes the encoder
     /// sees; measured no better, see docs/compression.md).
     #[serde(default = "default_metric")]
     pub metric: ReorderMetric,
@@ -135,16 +138,13 @@ impl Default for ReorderKnobs {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EncodeKnobs {
-    /// Dense-part encoding: `Bc6h` (default), `Bc1Log` (the seed's), `Bc4Log`, `F16`, `F32`.
+    /// Dense-part encoding: `Bc6h` (default), `Bc1Log` (the radiosity thesis's), `Bc4Log`, `F16`, `F32`.
     #[serde(default = "default_encoding")]
     pub encoding: DenseEncoding,
     /// Percentage of the entries (largest first) kept exactly in the sidecar.
-    #[serde(
-        default = "default_split",
-        deserialize_with = "checks::de::percent"
-    )]
+    #[serde(default = "default_split", deserialize_with = "checks::de::percent")]
     pub split_percent: f64,
-    /// Natural-log range of the log mapping (the seed's 25).
+    /// Natural-log range of the log mapping (the radiosity thesis's 25).
     #[serde(
         default = "default_log_range",
         deserialize_with = "checks::de::positive_f32"
@@ -169,7 +169,7 @@ pub struct EncodeKnobs {
 }
 
 /// The default encoding: BC6H with filled holes and a 1 % sidecar reached the goal
-/// (≤ 2 % RMS relative gather error at ≤ 1.5x the seed's bytes) by a wide margin; see
+/// (≤ 2 % RMS relative gather error at ≤ 1.5x the bytes of the radiosity thesis's scheme) by a wide margin; see
 /// docs/compression.md for the measurements.
 fn default_encoding() -> DenseEncoding {
     DenseEncoding::Bc6h
@@ -223,7 +223,6 @@ impl EncodeKnobs {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MinmaxMipmapKnobs {}
-
 
 impl VoxelizeKnobs {
     /// The parameters of [`crate::radiosity::voxelize::voxelize`].

@@ -4,8 +4,8 @@
 //! orientation, that patch is the answer without a distance test. A point under a coplanar cover (the Cornell
 //! ceiling above the light) lies on the cover's piece, so it finds the cover's patch.
 
-use super::geometry::{self, dominant_axis};
 use super::geometry::group_key;
+use super::geometry::{self, dominant_axis};
 use super::PatchSet;
 use crate::scene::Scene;
 use glam::DVec3;

@@ -173,4 +173,3 @@ pub fn is_permutation(perm: &[u32]) -> bool {
     }
     true
 }
-

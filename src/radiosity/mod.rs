@@ -1,10 +1,10 @@
-//! Radiosity bake, first half (DESIGN.md §3; seed 003 §3.5 and §4.1): the scene is simplified
+//! Radiosity bake, first half (docs/algorithms.md §3; the radiosity thesis §3.5, §4.1): the scene is simplified
 //! into patches ([`voxelize::voxelize`]), form factors between patches are estimated with BVH
 //! visibility ([`formfactor`]), and the k-bounce or infinite-bounce transport matrix
 //! `S = Σ_{h=1..k} (diag(ρ) F)^h` is precomputed ([`transport`]) so that the runtime gets the
 //! indirect light of any direct lighting `E` as one product `S · E` per colour channel.
 //!
-//! Conventions (DESIGN.md §9): patch emission is radiance L as in the scene; the exitance of an
+//! Conventions (docs/algorithms.md §9): patch emission is radiance L as in the scene; the exitance of an
 //! emitting patch is π·L; B, E and S·E are exitances; `F_ij` is the fraction of the energy leaving
 //! patch i that arrives at patch j, so the gathered irradiance is `H_i = Σ_j F_ij B_j` and
 //! `B = E + diag(ρ) F B`.
@@ -14,17 +14,17 @@
 //! docs/baked-format.md describes
 //! them byte by byte.
 
+pub mod corners;
 pub mod fixtures;
 pub mod formfactor;
 pub mod geometry;
 pub mod locate;
 pub mod matrix;
 pub mod overlap;
-pub mod voxelize;
 pub mod reference;
-pub mod corners;
 pub mod transport;
 pub mod visibility;
+pub mod voxelize;
 
 pub use matrix::TransportMatrix;
 use serde::{Deserialize, Serialize};

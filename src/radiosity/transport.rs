@@ -1,7 +1,7 @@
-//! `transport`: the k-bounce transport matrix of seed 003 §4.1 (DESIGN.md §3), per colour channel
+//! `transport`: the k-bounce transport matrix (docs/algorithms.md §3), per colour channel
 //!
 //! `S_k = Σ_{h=1..k} M^h`,  `M = diag(ρ) F`,  so that the indirect light of direct exitance E is
-//! `B_indirect = S_k · E` (the seed's `F^{k-reflections}`, with its "colour matrix" `F^C = M`),
+//! `B_indirect = S_k · E` (the radiosity thesis's `F^{k-reflections}`, §4.1, with its "colour matrix" `F^C = M`),
 //!
 //! and the limit `S_∞ = M (I − M)^{-1} = (I − M)^{-1} M`, solved by one LU factorisation (f64,
 //! partial pivoting, faer). Finite k uses f32 GEMMs (faer) by Horner's rule

@@ -5,7 +5,7 @@
 //! Triangles are tested with a watertight intersection (no rays lost through shared edges).
 //! Rays start slightly behind their origin to dodge obvhs's absolute 1e-4 near-hit cut-off.
 //! Occlusion uses `CwBvh::ray_traverse_miss`, which stops at the first hit below `tmax`;
-//! `ray_traverse_anyhit` is *not* an occlusion test (it visits every hit) — see BUILD-NOTES.
+//! `ray_traverse_anyhit` is *not* an occlusion test (it visits every hit) — see docs/dependencies.md.
 
 use super::geometry::Frame;
 use crate::scene::Scene;

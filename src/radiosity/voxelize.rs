@@ -1,5 +1,5 @@
-//! `voxelize`: simplify a scene into radiosity patches (DESIGN.md §3, after Shcherbakov & Frolov
-//! 2016, the seed's [1]).
+//! `voxelize`: simplify a scene into radiosity patches (docs/algorithms.md §3, after Shcherbakov & Frolov
+//! 2016, reference [1] of the radiosity thesis).
 //!
 //! 1. Skip degenerate (zero-area) triangles and count them.
 //! 2. Resolve coplanar overlapping faces ([`super::overlap`]): each region counts once, with the
@@ -201,7 +201,6 @@ pub fn live_triangles(scene: &Scene) -> Vec<u32> {
         .filter(|t| !degenerate.contains(&(*t as usize)))
         .collect()
 }
-
 
 fn lifted_centroid(p: &Piece, lift: f64) -> DVec3 {
     let poly: Vec<DVec3> = p.vertices.iter().map(|&v| DVec3::from(v)).collect();

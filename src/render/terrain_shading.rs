@@ -1,5 +1,5 @@
 //! The CPU twin of the terrain shading in `shaders/terrain_render.wgsl`: the same hypsometric
-//! tint, the same texel radiance (Lambert from `terrain::relief::lambert`, the seed's shadow
+//! tint, the same texel radiance (Lambert from `terrain::relief::lambert`, the relief-shadow paper's shadow
 //! brightness k_shadow) and the same tone map, evaluated per texel — what the GPU shows in the
 //! top-down map view, pixel for texel.
 
@@ -21,7 +21,7 @@ pub struct TerrainSettings {
     pub shadows: bool,
     /// Soft shadows of the sun's disc (branch-and-bound) instead of hard ones.
     pub soft: bool,
-    /// Aerial perspective (seed 001's scattered light), per pixel.
+    /// Aerial perspective (the function-based geometry paper's scattered light, docs/algorithms.md §6), per pixel.
     pub fog: bool,
     /// Extinction β_ext per metre.
     pub fog_extinction: f32,

@@ -1,7 +1,7 @@
-//! Compression sweeps (DESIGN.md §3 "Compression", §7): reorder passes, and split percentage ×
+//! Compression sweeps (docs/algorithms.md §3 "Compression", §7): reorder passes, and split percentage ×
 //! dense encoding. Reference: the uncompressed transport S (f32) and its dense mat-vec.
 //!
-//! Per setting: the seed's three numbers for the decoded matrix (mean, max and summed absolute
+//! Per setting: the radiosity thesis's three numbers for the decoded matrix (mean, max and summed absolute
 //! error, [`crate::compress::report::entry_errors`]) plus its RMS, the error of the gathered
 //! light `B = S·E` for the first light of the input (the scene's emitters when known) against
 //! the dense f32 product, the RMS relative gather error of the standard lights
@@ -16,13 +16,13 @@ use crate::compress::{
     compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric,
     ReorderOptions,
 };
-use crate::radiosity::TransportMatrix;
 use crate::error::Result;
 use crate::progress::Progress;
 use crate::radiosity::formfactor::FormFactorParams;
-use crate::radiosity::voxelize::Resolution;
 use crate::radiosity::transport::Bounces;
+use crate::radiosity::voxelize::Resolution;
 use crate::radiosity::PatchSet;
+use crate::radiosity::TransportMatrix;
 use crate::scene::Scene;
 use std::path::Path;
 
@@ -114,7 +114,11 @@ pub fn input_from_scene(
         ff.samples,
         b.transport.matrix.channels
     );
-    Ok(with_standard_lights(b.transport.matrix, emitters, description))
+    Ok(with_standard_lights(
+        b.transport.matrix,
+        emitters,
+        description,
+    ))
 }
 
 /// The transport of an existing bake (`transport.npy`; the emitters from `patches.bin` when it
@@ -190,7 +194,7 @@ fn f32_stats(approx: &[f32], exact: &[f32]) -> ErrorStats {
     ErrorStats::of(&a, &x, None)
 }
 
-/// The seed's scheme: Bc1Log, zeroed holes, no feedback, with a 4 % split.
+/// The radiosity thesis's scheme: Bc1Log, zeroed holes, no feedback, with a 4 % split.
 fn seed_options() -> EncodeOptions {
     EncodeOptions::default()
 }
@@ -222,7 +226,7 @@ pub fn run(
         .map(|l| l.0.clone())
         .unwrap_or_default();
 
-    // 1. Reorder passes, with the seed's encoding.
+    // 1. Reorder passes, with the radiosity thesis's encoding.
     let mut runs: Vec<(u8, ReorderMetric)> = Vec::new();
     let mut passes = cfg.passes.clone();
     passes.sort_unstable();
@@ -237,11 +241,11 @@ pub fn run(
         name: "compression_reorder".into(),
         title: "Compression: reorder passes".into(),
         description: format!(
-            "{}; greedy passes {passes:?} with the Linear (seed) and Log metrics; encoded with the seed's scheme (Bc1Log, p = 4 %, zeroed holes)",
+            "{}; greedy passes {passes:?} with the Linear (radiosity thesis) and Log metrics; encoded with the thesis's scheme (Bc1Log, p = 4 %, zeroed holes)",
             input.description
         ),
         reference: format!(
-            "the uncompressed matrix S: errors of the decoded entries (the seed's mean, max, sum) and of the gathered light B = S·E for the `{primary}` light against the dense f32 product"
+            "the uncompressed matrix S: errors of the decoded entries (the radiosity thesis's mean, max, sum) and of the gathered light B = S·E for the `{primary}` light against the dense f32 product"
         ),
         baseline: "0 passes".into(),
         time: "reorder".into(),
@@ -291,7 +295,7 @@ pub fn run(
         Column::new("reorder time", Measure::Seconds, Format::Time, false),
     ];
     reorder_sweep.notes.push(
-        "The seed reports mean 5.88e-7, max 0.1524, sum 9.40 after reordering vs 1.28e-6, 0.4622, 47.12 without (its own scene): reordering should cut the summed error about 5x.".into(),
+        "The radiosity thesis (Shcherbakov 2017, §4.2) reports mean 5.88e-7, max 0.1524, sum 9.40 after reordering vs 1.28e-6, 0.4622, 47.12 without (its own scene): reordering should cut the summed error about 5x.".into(),
     );
     reorder_sweep.error_plots(
         Measure::error("matrix", "sum"),
@@ -334,7 +338,7 @@ pub fn run(
         name: "compression_encoding".into(),
         title: "Compression: encoding and split".into(),
         description: format!(
-            "{}; {passes_used} Linear reorder passes; encodings {} × split p {:?} % with filled holes (the encode stage's default), plus the seed's scheme",
+            "{}; {passes_used} Linear reorder passes; encodings {} × split p {:?} % with filled holes (the encode stage's default), plus the radiosity thesis's scheme",
             input.description,
             cfg.encodings.iter().map(|e| e.name()).collect::<Vec<_>>().join(", "),
             cfg.split_percents

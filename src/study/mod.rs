@@ -1,6 +1,6 @@
-//! `relume-bake study`: the speed/accuracy sweeps of DESIGN.md §7. Every knob that trades speed
+//! `relume-bake study`: the speed/accuracy sweeps of docs/algorithms.md §7. Every knob that trades speed
 //! for accuracy is run at several settings and measured against a reference computed in the
-//! same run: error (mean, max, RMS, relative RMS and — for matrices — the seed's summed absolute
+//! same run: error (mean, max, RMS, relative RMS and — for matrices — the radiosity thesis's summed absolute
 //! error), wall time and bytes.
 //!
 //! - [`radiosity`]: patch count, form-factor estimator × samples, bounces (reference: the densest
@@ -31,7 +31,7 @@ use std::collections::BTreeMap;
 ///
 /// With weights `w` (areas, or 1) and differences `Δ = approx − reference`:
 /// `mean = Σ w|Δ| / Σ w`, `max = max |Δ|`, `rms = sqrt(Σ w Δ² / Σ w)`,
-/// `rms_rel = sqrt(Σ w Δ² / Σ w ref²)` (0 when both are zero), and `sum = Σ |Δ|` — the seed's
+/// `rms_rel = sqrt(Σ w Δ² / Σ w ref²)` (0 when both are zero), and `sum = Σ |Δ|` — the radiosity thesis's
 /// summed absolute error, given for matrices only.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct ErrorStats {
@@ -72,7 +72,7 @@ impl ErrorStats {
         }
     }
 
-    /// As [`ErrorStats::of`] over f32 matrix entries (weights 1), with the seed's summed error.
+    /// As [`ErrorStats::of`] over f32 matrix entries (weights 1), with the radiosity thesis's summed error.
     pub fn of_matrix(approx: &[f32], reference: &[f32]) -> ErrorStats {
         let a: Vec<f64> = approx.iter().map(|&v| v as f64).collect();
         let r: Vec<f64> = reference.iter().map(|&v| v as f64).collect();

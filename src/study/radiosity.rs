@@ -1,7 +1,7 @@
-//! Radiosity sweeps (DESIGN.md §7): patch count, form-factor estimator × samples, bounces.
+//! Radiosity sweeps (docs/algorithms.md §7): patch count, form-factor estimator × samples, bounces.
 //!
 //! The light measured is the gathered indirect exitance `B = S·E` of the scene's own emitters
-//! (`E_i = π·L_i` per channel, DESIGN.md §9), per patch and colour channel.
+//! (`E_i = π·L_i` per channel, docs/algorithms.md §9), per patch and colour channel.
 //!
 //! - **patches**: `voxelize` at each target patch count, then hemisphere form factors and
 //!   infinite bounces. Reference: the densest setting. Patch sets differ, so B is compared at
@@ -10,7 +10,7 @@
 //!   weighted by its share of the reference patch's area.
 //! - **estimator**: one patch set; hemisphere and pairwise form factors at several sample
 //!   counts; infinite bounces. Reference: hemisphere at the most samples. Errors of F itself
-//!   (the seed's summed error included) and of B per patch (area-weighted).
+//!   (the radiosity thesis's summed error included) and of B per patch (area-weighted).
 //! - **bounces**: one patch set and F; `Finite(k)`, `Infinite`, `Auto(tol)`. Reference: the f64
 //!   Gauss–Seidel solution of `B = E + diag(ρ) F B` ([`crate::radiosity::reference`]).
 
@@ -22,9 +22,9 @@ use crate::progress::{Progress, Silent};
 use crate::radiosity::formfactor::{form_factors, Estimator, FormFactorParams, FormFactors};
 use crate::radiosity::geometry::dominant_axis;
 use crate::radiosity::locate::PatchLocator;
-use crate::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use crate::radiosity::reference::{gauss_seidel, indirect};
 use crate::radiosity::transport::{transport, Bounces, Power, Transport, TransportParams};
+use crate::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use crate::radiosity::PatchSet;
 use crate::scene::Scene;
 use glam::DVec3;

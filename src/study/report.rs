@@ -3,8 +3,8 @@
 //! atomically; the directory is created when missing.
 
 use super::{plot, Column, Format, Setting, Study, Sweep};
-use crate::error::{Error, IoContext, Result};
 use crate::baked::images::write_atomic;
+use crate::error::{Error, IoContext, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 

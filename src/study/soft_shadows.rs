@@ -1,11 +1,11 @@
-//! Soft-shadow sweep (DESIGN.md §4 "soft shadows", §7): uniform stepping, the seed's dynamic
+//! Soft-shadow sweep (docs/algorithms.md §5, §7): uniform stepping, the soft-shadow paper's dynamic
 //! programming and branch-and-bound against the exhaustive reference (every texel on the sun
 //! track), on the maps the terrain study already built.
 //!
 //! The exhaustive reference walks the whole track at low sun, so every method runs on the same
 //! deterministic subset of rows (`rows` evenly spaced rows, all columns). Error = the lit
 //! fraction's absolute difference (mean, max, RMS). Baseline of each row: uniform-100 of the
-//! same size and elevation (the seed's baseline).
+//! same size and elevation (the soft-shadow paper's baseline).
 
 use super::timing::timed_cpu;
 use super::{Column, ErrorStats, Format, Measure, Setting, Sweep};
@@ -156,7 +156,7 @@ pub fn soft_shadow_sweep(
         Column::new("bytes", Measure::Bytes, Format::Bytes, false),
     ];
     sweep.notes.push(
-        "Ratios are against uniform stepping with 100 steps (the seed's baseline) on the same rows, size and elevation. Branch-and-bound finds the exact maximum, so its error is 0 up to f32 rounding of the lit fraction.".into(),
+        "Ratios are against uniform stepping with 100 steps (the soft-shadow paper's baseline) on the same rows, size and elevation. Branch-and-bound finds the exact maximum, so its error is 0 up to f32 rounding of the lit fraction.".into(),
     );
     sweep.error_plots(
         Measure::error("lit_fraction", "mean"),

@@ -1,4 +1,4 @@
-//! Terrain sweeps (DESIGN.md §4, §7): exact (A1) vs accelerated (A2) hard shadows at several map
+//! Terrain sweeps (docs/algorithms.md §4, §7): exact (A1) vs accelerated (A2) hard shadows at several map
 //! sizes (box-downsampled from the input with [`HeightMap::downsample`]) and sun elevations, and
 //! the min/max mipmap build. Reference: the exact traversal's mask; the accelerated traversal
 //! must differ on 0 pixels, so its "error" is the count of differing pixels (`sum`), as a

@@ -1,4 +1,4 @@
-//! Accelerated relief-shadow traversal over the min/max mipmap: the seed's algorithm A2
+//! Accelerated relief-shadow traversal over the min/max mipmap: algorithm A2 of the relief-shadow paper
 //! (Timokhin & Mikhaylyuk 2021, §4), with the same answer as [`shadowed_exact`] on every
 //! pixel.
 //!

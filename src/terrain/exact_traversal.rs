@@ -1,4 +1,4 @@
-//! Exact relief-shadow traversal: the seed's algorithm A1 (Timokhin & Mikhaylyuk 2021, §4),
+//! Exact relief-shadow traversal: algorithm A1 of the relief-shadow paper (Timokhin & Mikhaylyuk 2021, §4),
 //! the reference every faster method is compared with.
 //!
 //! A pixel P (texel centre p = (col + ½, row + ½), height z_P = its texel's height) is in shadow
@@ -8,7 +8,7 @@
 //!     h(Q_T) − z_P  >  rise_per_t · t_T          (strict: touching the ray is lit)
 //! ```
 //!
-//! where t_T = (t_in + t_out)/2 is the midpoint of the track's transit through T (the seed's
+//! where t_T = (t_in + t_out)/2 is the midpoint of the track's transit through T (the relief-shadow paper's
 //! "two transit points") and Q_T = p + u·t_T, clamped into T's square, is sampled bilinearly
 //! ([`sample_bilinear`]). The start texel (P's own) is tested too, so a plane facing away from
 //! the sun more steeply than the sun's elevation shadows itself.

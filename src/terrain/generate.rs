@@ -1,4 +1,4 @@
-//! Synthetic height maps: the seed's stress maps ("spikes": thin tall cones; "steps": sharp
+//! Synthetic height maps: the relief-shadow paper's stress maps ("spikes": thin tall cones; "steps": sharp
 //! terraces) and analytic shapes whose shadows have closed forms (wall, cone, hemisphere,
 //! crater). All are N×N texels of 1 m with heights in metres; the feature scale is
 //! H = N/4 m (so shapes keep their proportions at any size).

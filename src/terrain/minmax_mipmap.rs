@@ -1,4 +1,4 @@
-//! The min/max mipmap (DESIGN.md §4; seed 000's {h_max, h_min} mipmap): the acceleration
+//! The min/max mipmap (docs/algorithms.md §4; the relief-shadow paper's {h_max, h_min} mipmap): the acceleration
 //! structure of the accelerated hard-shadow traversal and of the soft-shadow methods.
 //!
 //! Level 0 is half the map's size (rounded up): texel (bx, by) bounds block
@@ -9,13 +9,13 @@
 //!
 //! **Bounds.** Level 0 stores the max and min of the texels in the block *plus a one-texel
 //! border* (the 4×4 texels [2bx−1, 2bx+2] × [2by−1, 2by+2], clamped to the map) — the footprint
-//! of the seed's 3×3 pattern of bilinear samples, with texel values instead of averages. Why
+//! of the relief-shadow paper's 3×3 pattern of bilinear samples, with texel values instead of averages. Why
 //! this is conservative for every value the exact traversal samples in the block: a sample of
 //! texel T is taken at a point Q clamped into T's square, and [`sample_bilinear`] clamps its
 //! result to the range of the four texels of Q's bilinear cell; for Q in T's square those four
 //! texels lie within one texel of T (border-clamped), hence inside the block's bordered
 //! footprint. So every sample h satisfies min ≤ h ≤ max, exactly, in floating point (no
-//! rounding is involved in a min/max of f32 values); `tests/terrain_mipmap.rs` checks it with
+//! rounding is involved in a min/max of f32 values); `tests/terrain_exactness.rs` checks it with
 //! proptest. The bound is looser than the exact range of bilinear values (which would need
 //! averages and outward rounding to stay provable) only next to a block's border.
 //!
@@ -155,7 +155,6 @@ impl MinMaxMipmap {
     pub fn bytes(&self) -> usize {
         self.data.len() * 4
     }
-
 }
 
 pub fn top_max_min(levels: &[MipLevel], data: &[f32]) -> (f32, f32) {

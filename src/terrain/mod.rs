@@ -1,4 +1,4 @@
-//! Terrain: relief shadows on height maps (DESIGN.md §4, §5).
+//! Terrain: relief shadows on height maps (docs/algorithms.md §4, §5).
 //!
 //! - [`sun`]: the sun direction and its track in texel space (the constants every kernel uses);
 //! - [`exact_traversal`]: hard shadows by visiting every texel on the track (algorithm A1, the reference);

@@ -1,6 +1,6 @@
-//! Whole-image hard shadows and shaded relief (DESIGN.md §4): a shadow mask from the exact or
+//! Whole-image hard shadows and shaded relief (docs/algorithms.md §4): a shadow mask from the exact or
 //! the accelerated traversal, parallel over rows, and a Lambert-shaded relief darkened by the
-//! seed's shadow brightness k_shadow = k_dark + (k_bright − k_dark)·(s·up).
+//! relief-shadow paper's shadow brightness (eq. 4) k_shadow = k_dark + (k_bright − k_dark)·(s·up).
 
 use super::accelerated_traversal::shadowed_accelerated;
 use super::exact_traversal::shadowed_exact;
@@ -62,7 +62,7 @@ pub fn shadow_mask(
     rows.concat()
 }
 
-/// The seed's shadow brightness: k_dark + (k_bright − k_dark)·(s·up), s·up = sin(elevation)
+/// The relief-shadow paper's shadow brightness (eq. 4): k_dark + (k_bright − k_dark)·(s·up), s·up = sin(elevation)
 /// (clamped at 0 for a sun below the horizon).
 pub fn k_shadow(sun: &Sun, k_dark: f64, k_bright: f64) -> f64 {
     k_dark + (k_bright - k_dark) * sun.up_component().max(0.0)

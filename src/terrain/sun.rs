@@ -1,4 +1,4 @@
-//! The sun and its track through a height map (DESIGN.md §4, §9).
+//! The sun and its track through a height map (docs/algorithms.md §4, §9).
 //!
 //! Convention: azimuth in degrees clockwise from north (+y, toward row 0), elevation in degrees
 //! above the horizon; the unit vector toward the sun is (sin az · cos el, cos az · cos el, sin el)

@@ -147,7 +147,8 @@ pub fn transport(s: &BoxScene, bounces: Option<usize>) -> TransportMatrix {
 /// takes a while), or the matrix named by `RELUME_TRANSPORT_NPY` when that is set.
 pub fn transport_or_env(k: usize, bounces: Option<usize>) -> TransportMatrix {
     if let Ok(p) = std::env::var("RELUME_TRANSPORT_NPY") {
-        return relume::baked::transport::read_file(std::path::Path::new(&p)).expect("RELUME_TRANSPORT_NPY");
+        return relume::baked::transport::read_file(std::path::Path::new(&p))
+            .expect("RELUME_TRANSPORT_NPY");
     }
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/relume-test-cache");
     let name = format!(

@@ -4,10 +4,10 @@ use super::{record, StageRun};
 use crate::bake::estimate::{PlanState, PlannedStage};
 use crate::bake::workspace::Workspace;
 use crate::baked::{self, BakeTransaction, StageRecord};
+use crate::compress::compress;
 use crate::compress::dense::DenseEncoding;
 use crate::compress::reorder::reorder;
 use crate::compress::report::{report, standard_lights};
-use crate::compress::compress;
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::{EncodeKnobs, ReorderKnobs};
 use crate::progress::Progress;
@@ -147,4 +147,3 @@ impl StageRun for EncodeKnobs {
         }
     }
 }
-

@@ -123,7 +123,8 @@ pub fn run(cmd: &CompressCommand, ui: &Ui, json: bool, quiet: bool) -> Result<i3
             light_npy,
             out,
         } => {
-            let (ch, n) = relume::baked::export::gather(baked_dir, *light, light_npy.as_deref(), out)?;
+            let (ch, n) =
+                relume::baked::export::gather(baked_dir, *light, light_npy.as_deref(), out)?;
             if json {
                 crate::print_json(
                     &serde_json::json!({"out": out.display().to_string(), "channels": ch, "patches": n}),

@@ -1,4 +1,4 @@
-//! `relume-bake study radiosity|compression|terrain`: the speed/accuracy sweeps of DESIGN.md §7.
+//! `relume-bake study radiosity|compression|terrain`: the speed/accuracy sweeps of docs/algorithms.md §7.
 //! Thin: resolve the input (defaults: the bundled Cornell box and Puget Sound), pick the full or
 //! quick configuration with the command line's overrides, run `relume::study`, write the report.
 
@@ -167,7 +167,12 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
             Study::new("radiosity", name, quick, radiosity::run(&scene, &cfg, ui)?)
         }
         Which::Compression(a) => {
-            let input = inputs::compression_input(a.baked.as_deref(), &source(&a.source), a.patches, quick)?;
+            let input = inputs::compression_input(
+                a.baked.as_deref(),
+                &source(&a.source),
+                a.patches,
+                quick,
+            )?;
             let cfg = if quick {
                 compression::CompressionConfig::quick()
             } else {
@@ -177,7 +182,12 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
             Study::new("compression", input.description.clone(), quick, sweeps)
         }
         Which::Terrain(a) => {
-            let (map, name) = inputs::heightmap(a.heightmap.as_deref(), a.pipeline.as_deref(), a.cell_size, a.height_scale)?;
+            let (map, name) = inputs::heightmap(
+                a.heightmap.as_deref(),
+                a.pipeline.as_deref(),
+                a.cell_size,
+                a.height_scale,
+            )?;
             let mut cfg = if quick {
                 terrain::TerrainConfig::quick()
             } else {

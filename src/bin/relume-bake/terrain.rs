@@ -3,12 +3,12 @@
 
 use crate::ui::Ui;
 use clap::{Args, ValueEnum};
-use relume::render::tonemap::linear_to_srgb8;
+use relume::baked::images::{self, check_extension};
 use relume::error::exit;
 use relume::heightmap::HeightMap;
 use relume::progress::Progress;
+use relume::render::tonemap::linear_to_srgb8;
 use relume::terrain::generate::{generate, quantise_u16, Shape};
-use relume::baked::images::{self, check_extension};
 use relume::terrain::relief::{self, HardMethod};
 use relume::terrain::soft::{soft_shadow_map, SoftMethod, SoftShadowParams};
 use relume::terrain::Sun;
@@ -121,9 +121,9 @@ pub struct GenerateArgs {
 pub enum SoftMethodArg {
     /// Every texel on the track (the reference; slow at low sun)
     Exhaustive,
-    /// --steps evenly spaced samples (the seed's baseline)
+    /// --steps evenly spaced samples (the soft-shadow paper's baseline)
     Uniform,
-    /// The seed's dynamic programming over the mipmap (--start-level, --intervals)
+    /// The soft-shadow paper's dynamic programming over the mipmap (--start-level, --intervals)
     DynamicProgramming,
     /// The exact answer by branch-and-bound over the mipmap
     BranchAndBound,

@@ -1,5 +1,5 @@
 //! `form_factors`: F_ij, the fraction of the energy leaving patch i that arrives at patch j
-//! (DESIGN.md §3):
+//! (docs/algorithms.md §3):
 //!
 //! `F_ij = 1/A_i ∫_{A_i} ∫_{A_j} cosθ_i cosθ_j / (π r²) · V(x, y) dA_j dA_i`
 //!
@@ -17,8 +17,8 @@ pub mod hemisphere;
 pub mod pairwise;
 
 use super::locate::PatchLocator;
-use super::voxelize::{live_triangles, piece_sampler};
 use super::visibility::Visibility;
+use super::voxelize::{live_triangles, piece_sampler};
 use super::PatchSet;
 use crate::error::{Error, Result};
 use crate::progress::Progress;

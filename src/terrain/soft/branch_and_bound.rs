@@ -1,4 +1,4 @@
-//! Soft shadows, exact and fast: branch-and-bound over the min/max mipmap (beyond the seed).
+//! Soft shadows, exact and fast: branch-and-bound over the min/max mipmap (beyond the soft-shadow paper).
 //!
 //! The traversal of [`crate::terrain::accelerated_traversal`] with a continuous criterion: the
 //! state is the exact traversal's texel and entry time plus a level; a block is skipped when the

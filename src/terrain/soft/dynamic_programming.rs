@@ -1,4 +1,4 @@
-//! Soft shadows by the seed's dynamic programming over the max mipmap (Jung et al. 2020,
+//! Soft shadows by the soft-shadow paper's dynamic programming over the max mipmap (Jung et al. 2020,
 //! §3.2–3.3, Algorithm 1), adapted to relume's min/max mipmap and texel samples.
 //!
 //! The track is cut into intervals of length ℓ = B_s / max(|u_x|, |u_y|) — one texel of the
@@ -114,7 +114,7 @@ pub fn lit_dynamic_programming(
                         let ub =
                             slope_upper_bound(hi_f, lo_f, ps.zp, m * b_in, m * b_out, ps.radius);
                         bound = bound.max(ub);
-                        // Keep the block whose bound is largest (the seed's "smallest cost";
+                        // Keep the block whose bound is largest (the paper's "smallest cost";
                         // evaluating the max height at the middle of the block's stretch
                         // instead measured slightly worse on Puget Sound).
                         if ub > chosen.0 {

@@ -1,9 +1,9 @@
-//! Soft shadows of the sun's disc on (optionally curved) terrain (DESIGN.md §5; seed 002, Jung,
+//! Soft shadows of the sun's disc on (optionally curved) terrain (docs/algorithms.md §5; the soft-shadow paper, Jung,
 //! Schrempp & Son 2020): the model in [`model`], four ways to find the most occluding point:
 //!
 //! - [`exhaustive`]: every texel on the track — the reference;
-//! - [`uniform`]: `steps` evenly spaced samples — the seed's baseline;
-//! - [`dynamic_programming`]: the seed's method over the mipmap, greedy and approximate;
+//! - [`uniform`]: `steps` evenly spaced samples — the soft-shadow paper's baseline;
+//! - [`dynamic_programming`]: the soft-shadow paper's method over the mipmap, greedy and approximate;
 //! - [`branch_and_bound`]: the exact maximum over the mipmap, pruning blocks by bounds.
 //!
 //! Per-pixel kernels are plain loops over flat arrays, like the hard-shadow ones.
@@ -29,9 +29,9 @@ use serde::{Deserialize, Serialize};
 pub enum SoftMethod {
     /// Every texel on the track (the reference).
     Exhaustive,
-    /// `steps` evenly spaced samples (the seed's baseline uses 100).
+    /// `steps` evenly spaced samples (the soft-shadow paper's baseline uses 100).
     Uniform { steps: u32 },
-    /// The seed's dynamic programming from `start_level` (−1 = texels; clamped to the top
+    /// The soft-shadow paper's dynamic programming from `start_level` (−1 = texels; clamped to the top
     /// level) over `intervals` intervals (0 = as many as the track needs).
     DynamicProgramming { start_level: i32, intervals: u32 },
     /// The exact maximum by branch-and-bound over the mipmap.

@@ -1,4 +1,4 @@
-//! The soft-shadow model (DESIGN.md §5, seed 002 §3.1 and §3.4): one ray from P toward the
+//! The soft-shadow model (docs/algorithms.md §5; the soft-shadow paper §3.1 and §3.4): one ray from P toward the
 //! centre of the sun disc; the most occluding point on the track decides how much of the disc
 //! is visible, assuming the occluder is a prism across the ray (exact for a straight wall).
 //!

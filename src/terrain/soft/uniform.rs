@@ -1,4 +1,4 @@
-//! Soft shadows by uniform stepping (the seed's baseline, Jung et al. 2020 §2/§6.3: 100 fixed
+//! Soft shadows by uniform stepping (the soft-shadow paper's baseline, Jung et al. 2020 §2/§6.3: 100 fixed
 //! steps): `steps` bilinear samples at t_i = (i + ½)·L/steps along the track, where L is the
 //! distance to the map's border or, when shorter, to where a flat ray at e_P − α clears the
 //! map's highest point (beyond it nothing can dim the disc: "the ray leaves the terrain
