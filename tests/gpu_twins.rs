@@ -993,13 +993,7 @@ fn direct_light_kernel_with_punctual_lights_and_shadow_maps_matches_its_twin() {
     let n = set.patches.len();
     let mut renderer = MeshRenderer::new(&gpu, &scene, 8, 8, 1024).unwrap();
     let zeros = relume::radiosity::TransportMatrix::zeros(1, n);
-    let rt = RadiosityRuntime::new(
-        &gpu,
-        &set,
-        TransportSource::Dense(&zeros),
-        &renderer,
-    )
-    .unwrap();
+    let rt = RadiosityRuntime::new(&gpu, &set, TransportSource::Dense(&zeros), &renderer).unwrap();
     let mut point = light(
         LightKind::Point,
         Vec3::new(0.0, 1.4, 0.0),

@@ -42,7 +42,7 @@ pub struct AdapterReport {
 }
 
 /// Which graphics API to use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
 pub enum BackendChoice {
     Vulkan,
     Gl,
@@ -67,18 +67,25 @@ pub const NO_ADAPTER_HINT: &str =
      `sudo apt-get install mesa-vulkan-drivers libvulkan1` (or `make deps`); \
      or try `--backend gl` with `libegl1 libegl-mesa0 libgl1-mesa-dri`";
 
+/// The instance every window and headless device is made from: `backend`, else `WGPU_BACKEND`
+/// from the environment, else Vulkan then GL.
+pub fn instance_descriptor(backend: Option<BackendChoice>) -> wgpu::InstanceDescriptor {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    match backend {
+        Some(b) => desc.backends = b.backends(),
+        None if std::env::var_os("WGPU_BACKEND").is_none() => {
+            desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL
+        }
+        None => {}
+    }
+    desc
+}
+
 impl Gpu {
     /// Open a device. `backend` None means `WGPU_BACKEND` from the environment, else Vulkan
     /// then GL. Requests BC textures and timestamp queries when the adapter has them.
     pub fn new(backend: Option<BackendChoice>) -> Result<Gpu> {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        match backend {
-            Some(b) => desc.backends = b.backends(),
-            None if std::env::var_os("WGPU_BACKEND").is_none() => {
-                desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL
-            }
-            None => {}
-        }
+        let desc = instance_descriptor(backend);
         let instance = wgpu::Instance::new(desc);
         Self::from_instance(&instance, None)
     }

@@ -1,9 +1,11 @@
 //! The runtime: load a baked directory and render frames with wgpu. The binary
 //! (`relume-player`) only parses arguments and runs the window or headless loop around this.
 
+pub mod headless;
 pub mod light_spec;
 mod mesh;
 mod terrain;
+pub mod window;
 
 pub use mesh::MeshPlayer;
 pub use terrain::TerrainPlayer;
@@ -22,7 +24,7 @@ use std::path::Path;
 pub use crate::terrain::sun::Sun;
 
 /// Which transport the runtime gathers from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
 pub enum TransportChoice {
     /// The encoded transport when the bake has one, else the dense matrix.
     #[default]

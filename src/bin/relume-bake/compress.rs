@@ -8,10 +8,10 @@ use relume::compress::containers::Container;
 use relume::compress::dense::DenseEncoding;
 use relume::compress::reorder::ReorderMetric;
 use relume::error::exit;
-use relume::pipeline::checks::arg;
+use relume::pipeline::checks::{self, arg};
 use relume::pipeline::knobs::{EncodeKnobs, ReorderKnobs};
 use relume::pipeline::Stage;
-use relume::Result;
+use relume::{Error, Result};
 use std::path::PathBuf;
 
 #[derive(Subcommand)]
@@ -69,7 +69,7 @@ pub struct EncodeArgs {
     #[arg(long, value_name = "BOOL")]
     fill_holes: Option<bool>,
     /// Largest texture side; bigger matrices are tiled (a multiple of 4; default 8192)
-    #[arg(long, value_name = "N", value_parser = arg::texture_size)]
+    #[arg(long, value_name = "N")]
     max_texture_size: Option<u32>,
     /// Containers to write (repeat or comma-separate; default dds,ktx2)
     #[arg(long = "container", value_enum, value_delimiter = ',')]
@@ -77,27 +77,32 @@ pub struct EncodeArgs {
 }
 
 impl EncodeArgs {
-    fn knobs(&self) -> EncodeKnobs {
+    fn knobs(&self) -> Result<EncodeKnobs> {
         let d = EncodeKnobs::default();
+        let max_texture_size = match self.max_texture_size {
+            Some(m) => checks::texture_size(m)
+                .map_err(|e| Error::knob(format!("--max-texture-size: {e}")))?,
+            None => d.max_texture_size,
+        };
         let mut containers = Vec::new();
         for c in &self.containers {
             if !containers.contains(c) {
                 containers.push(*c);
             }
         }
-        EncodeKnobs {
+        Ok(EncodeKnobs {
             encoding: self.encoding.unwrap_or(d.encoding),
             split_percent: self.split_percent.unwrap_or(d.split_percent),
             log_range: self.log_range.unwrap_or(d.log_range),
             feedback: self.feedback.unwrap_or(d.feedback),
             fill_holes: self.fill_holes.unwrap_or(d.fill_holes),
-            max_texture_size: self.max_texture_size.unwrap_or(d.max_texture_size),
+            max_texture_size,
             containers: if containers.is_empty() {
                 d.containers
             } else {
                 containers
             },
-        }
+        })
     }
 }
 
@@ -116,7 +121,7 @@ pub fn run(cmd: &CompressCommand, ui: &Ui, json: bool, quiet: bool) -> Result<i3
             };
             (baked_dir, Stage::Reorder(knobs))
         }
-        CompressCommand::Encode { baked_dir, knobs } => (baked_dir, Stage::Encode(knobs.knobs())),
+        CompressCommand::Encode { baked_dir, knobs } => (baked_dir, Stage::Encode(knobs.knobs()?)),
         CompressCommand::Gather {
             baked_dir,
             light,

@@ -1,13 +1,13 @@
 //! The interactive window (winit): orbit camera, sun keys, toggles, frame time in the title.
 
-use relume::error::{Error, Result};
-use relume::gpu::blit::Blit;
-use relume::gpu::timing::PassTimer;
-use relume::gpu::{BackendChoice, Gpu};
-use relume::player::{Player, PlayerOptions, Sun};
-use relume::render::camera::Camera;
-use relume::render::mesh_reference::FrameSettings;
-use relume::scene::Light;
+use crate::error::{Error, Result};
+use crate::gpu::blit::Blit;
+use crate::gpu::timing::PassTimer;
+use crate::gpu::{BackendChoice, Gpu};
+use crate::player::{Player, PlayerOptions, Sun};
+use crate::render::camera::Camera;
+use crate::render::mesh_reference::FrameSettings;
+use crate::scene::Light;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -130,15 +130,7 @@ impl App {
             el.create_window(attrs)
                 .map_err(|e| Error::Gpu(format!("cannot create a window: {e}")))?,
         );
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        if let Some(b) = self.plan.backend {
-            desc.backends = match b {
-                BackendChoice::Vulkan => wgpu::Backends::VULKAN,
-                BackendChoice::Gl => wgpu::Backends::GL,
-                BackendChoice::Metal => wgpu::Backends::METAL,
-                BackendChoice::Dx12 => wgpu::Backends::DX12,
-            };
-        }
+        let desc = crate::gpu::instance_descriptor(self.plan.backend);
         let instance = wgpu::Instance::new(desc);
         let surface = instance
             .create_surface(window.clone())

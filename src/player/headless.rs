@@ -1,0 +1,168 @@
+//! Headless rendering: frames to PNG and `frames.json` (adapter, per-frame CPU time and per-pass
+//! GPU timestamps). `relume-player --headless` and `benches/player_frames.rs` share it.
+
+use super::{FrameTimes, Player, PlayerOptions, Sun};
+use crate::baked::images::write_atomic;
+use crate::error::{Error, Result};
+use crate::gpu::timing::PassTimer;
+use crate::gpu::{AdapterReport, Gpu};
+use crate::render::camera::Camera;
+use crate::render::mesh_reference::FrameSettings;
+use crate::scene::Light;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What to render headless.
+#[derive(Clone, Debug)]
+pub struct HeadlessPlan {
+    pub dir: PathBuf,
+    pub out: PathBuf,
+    pub size: (u32, u32),
+    pub frames: u32,
+    /// The sun of frame 0; it turns a full circle in azimuth over the frames.
+    pub sun: Option<Sun>,
+    pub lights: Vec<Light>,
+    /// Default: the player's framing of the scene.
+    pub camera: Option<Camera>,
+    pub settings: FrameSettings,
+    pub options: PlayerOptions,
+}
+
+/// `frames.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct HeadlessReport {
+    pub adapter: AdapterReport,
+    pub size: [u32; 2],
+    pub note: &'static str,
+    pub frames: Vec<FrameTimes>,
+}
+
+/// The sun of frame `f` of `frames`: `sun` turned by `360° · f / frames` in azimuth.
+pub fn sun_of_frame(sun: Sun, f: u32, frames: u32) -> Sun {
+    Sun {
+        azimuth_deg: sun.azimuth_deg + 360.0 * f as f64 / frames.max(1) as f64,
+        ..sun
+    }
+}
+
+/// Render every frame of `plan` into `plan.out` (`frame_NNNN.png`, then `frames.json`).
+pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
+    let (w, h) = plan.size;
+    let mut player = Player::load(gpu, &plan.dir, &plan.options, w, h)?;
+    player.add_lights(gpu, &plan.lights)?;
+    let camera = plan.camera.unwrap_or_else(|| player.default_camera());
+    std::fs::create_dir_all(&plan.out)
+        .map_err(|e| Error::io(&plan.out, "cannot create output directory", e))?;
+    let mut timer = PassTimer::new(gpu, 48);
+    let mut frames = Vec::new();
+    for f in 0..plan.frames {
+        let sun = plan.sun.map(|s| sun_of_frame(s, f, plan.frames));
+        let t0 = Instant::now();
+        player.set_sun(gpu, sun)?;
+        player.render(gpu, &camera, &plan.settings, &mut timer)?;
+        let cpu_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = timer
+            .read(gpu)?
+            .into_iter()
+            .map(|(n, t)| (n.to_string(), t))
+            .collect();
+        let img = player.read_image(gpu)?;
+        write_png(&plan.out.join(format!("frame_{f:04}.png")), &img)?;
+        frames.push(FrameTimes {
+            frame: f,
+            cpu_ms,
+            gpu_ms,
+        });
+    }
+    let report = HeadlessReport {
+        adapter: gpu.info.clone(),
+        size: [w, h],
+        note: "cpu_ms is wall time to record, submit and wait; on a software rasteriser (llvmpipe/lavapipe) these are CPU times, not GPU times",
+        frames,
+    };
+    let json = serde_json::to_string_pretty(&report).expect("report serialises");
+    write_atomic(&plan.out.join("frames.json"), |tmp| {
+        std::fs::write(tmp, json.as_bytes()).map_err(|e| Error::io(tmp, "cannot write", e))
+    })?;
+    Ok(report)
+}
+
+/// Write an RGBA image as PNG, atomically.
+pub fn write_png(path: &Path, img: &image::RgbaImage) -> Result<()> {
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
+    write_atomic(path, |tmp| {
+        std::fs::write(tmp, &bytes).map_err(|e| Error::io(tmp, "cannot write", e))
+    })
+}
+
+/// Command-line values of the player, parsed and checked here so that the binary stays thin.
+pub mod args {
+    use super::{Camera, Sun};
+
+    /// `WIDTHxHEIGHT`, each in 1..=16384.
+    pub fn size(s: &str) -> Result<(u32, u32), String> {
+        let (w, h) = crate::pipeline::checks::arg::wxh(s)?;
+        if w > 16384 || h > 16384 {
+            return Err("width and height must be in 1..=16384".into());
+        }
+        Ok((w as u32, h as u32))
+    }
+
+    fn floats(s: &str) -> Result<Vec<f32>, String> {
+        s.split(',')
+            .map(|t| {
+                t.trim()
+                    .parse::<f32>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| format!("`{t}` is not a finite number"))
+            })
+            .collect()
+    }
+
+    /// `AZIMUTH,ELEVATION` in degrees, elevation in [−90, 90].
+    pub fn sun(s: &str) -> Result<Sun, String> {
+        match floats(s)?.as_slice() {
+            [az, el] if (-90.0..=90.0).contains(el) => Ok(Sun {
+                azimuth_deg: *az as f64,
+                elevation_deg: *el as f64,
+            }),
+            [_, el] => Err(format!("elevation {el} is outside -90..=90 degrees")),
+            _ => Err(format!("`{s}` is not AZIMUTH,ELEVATION (e.g. 135,30)")),
+        }
+    }
+
+    /// `EX,EY,EZ,TX,TY,TZ[,FOV]`: eye, target and the vertical field of view in degrees.
+    pub fn camera(s: &str) -> Result<Camera, String> {
+        let v = floats(s)?;
+        if v.len() != 6 && v.len() != 7 {
+            return Err(format!(
+                "`{s}` needs 6 or 7 numbers: eye x,y,z, target x,y,z[, fov]"
+            ));
+        }
+        let eye = glam::Vec3::new(v[0], v[1], v[2]);
+        let target = glam::Vec3::new(v[3], v[4], v[5]);
+        let d = (target - eye).length();
+        if d <= 0.0 {
+            return Err("eye and target must differ".into());
+        }
+        let fov = v.get(6).copied().unwrap_or(39.3077);
+        if !(1.0..=170.0).contains(&fov) {
+            return Err(format!("field of view {fov} is outside 1..=170 degrees"));
+        }
+        Ok(Camera {
+            eye,
+            target,
+            up: glam::Vec3::Y,
+            fov_y_deg: fov,
+            near: d * 1e-3,
+            far: d * 100.0,
+        })
+    }
+}
