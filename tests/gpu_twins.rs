@@ -1267,7 +1267,7 @@ fn shared_structs() -> Vec<Shared> {
             &["n", "channel", "_pad0", "_pad1"],
         ),
         words(
-            "corner_transfer.wgsl",
+            "corner_interpolate.wgsl",
             "TransferParams",
             &["corners", "_pad0", "_pad1", "_pad2"],
         ),

@@ -6,7 +6,7 @@
 //! TransportMatrix S ─▶ reorder (permutation P, S' = P S Pᵀ)   [reorder.rs]
 //!   ─▶ split: top p % entries → Sidecar (CSR, f32)            [split.rs]
 //!   ─▶ dense rest: log map → 8-bit codes                       [logmap.rs]
-//!   ─▶ block texture (BC1 / BC4 / BC6H / F16 / F32)            [bc1.rs, blocks.rs, dense.rs]
+//!   ─▶ block texture (BC1 / BC4 / BC6H / F16 / F32)            [bc1.rs, bc4.rs, bc6h.rs, encode.rs]
 //!   ─▶ DDS / KTX2 files (tiled when wider than the max size)   [containers.rs]
 //! gather: B_ind = S · E straight from the compressed form      [gather.rs]
 //! report: the thesis's three errors, RMS relative error of B_ind [report.rs]
