@@ -8,13 +8,13 @@
 //! `cargo bench --bench player_frames [-- --frames N]`
 
 use relume::bake::{run_pipeline, BakeOptions};
-use relume::gpu::{timing::PassTimer, Gpu};
+use relume::gpu::Gpu;
 use relume::pipeline::parse_pipeline;
-use relume::player::{Player, PlayerOptions, Sun};
+use relume::player::headless::{render_frames, HeadlessPlan};
+use relume::player::{PlayerOptions, Sun};
 use relume::render::mesh_reference::FrameSettings;
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::time::Instant;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());
@@ -65,34 +65,35 @@ fn main() {
         let dir = tmp.join(Path::new(pipeline).file_stem().unwrap());
         run_pipeline(&p, &dir, &BakeOptions::default(), &relume::progress::Silent).expect("bake");
         for (w, h) in [(640u32, 480u32), (1920, 1080)] {
-            let mut player =
-                Player::load(&gpu, &dir, &PlayerOptions::default(), w, h).expect("load");
-            let camera = player.default_camera();
             for (label, soft) in &configs {
-                // None: no shadows; Some(soft): hard or soft shadows.
-                let s = FrameSettings {
-                    shadows: soft.is_some(),
-                    soft_shadows: soft.unwrap_or(false),
-                    exposure: 2.0,
-                    ..Default::default()
+                // None: no shadows; Some(soft): hard or soft shadows. The headless loop of
+                // relume-player itself; frame 0 is the warm-up.
+                let plan = HeadlessPlan {
+                    dir: dir.clone(),
+                    out: tmp.join("frames"),
+                    size: (w, h),
+                    frames: frames as u32 + 1,
+                    sun: Some(Sun {
+                        azimuth_deg: 300.0,
+                        elevation_deg: 12.0,
+                    }),
+                    lights: Vec::new(),
+                    camera: None,
+                    settings: FrameSettings {
+                        shadows: soft.is_some(),
+                        soft_shadows: soft.unwrap_or(false),
+                        exposure: 2.0,
+                        ..Default::default()
+                    },
+                    options: PlayerOptions::default(),
                 };
-                let mut timer = PassTimer::new(&gpu, 48);
+                let report = render_frames(&gpu, &plan).expect("frames");
                 let mut wall = Vec::new();
                 let mut passes: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-                for f in 0..=frames {
-                    let sun = Sun {
-                        azimuth_deg: 300.0 + 10.0 * f as f64,
-                        elevation_deg: 12.0,
-                    };
-                    let t0 = Instant::now();
-                    player.set_sun(&gpu, Some(sun)).unwrap();
-                    player.render(&gpu, &camera, &s, &mut timer).unwrap();
-                    let ms = t0.elapsed().as_secs_f64() * 1e3;
-                    if f > 0 {
-                        wall.push(ms);
-                        for (n, t) in timer.read(&gpu).unwrap() {
-                            passes.entry(n.to_string()).or_default().push(t);
-                        }
+                for f in &report.frames[1..] {
+                    wall.push(f.cpu_ms);
+                    for (n, t) in &f.gpu_ms {
+                        passes.entry(n.clone()).or_default().push(*t);
                     }
                 }
                 let per_pass: Vec<String> = passes

@@ -239,7 +239,7 @@ fn resolve(tree: &Tree, from: &[String], path: &[String]) -> Option<Vec<String>>
         Some("super") | Some("self") => from.to_vec(),
         _ => return None,
     };
-    let mut segs = &path[..];
+    let mut segs = path;
     // Leading `super::super::…`: a file's `super` is its parent module.
     while let Some(first) = segs.first() {
         match first.as_str() {

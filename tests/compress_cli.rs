@@ -39,7 +39,7 @@ fn bake_with_transport(tmp: &Path, name: &str, s: &TransportMatrix) -> PathBuf {
         ],
     );
     expect_code(&o, 0);
-    relume::baked::transport::write_file(&dir.join("transport.npy"), &s).unwrap();
+    relume::baked::transport::write_file(&dir.join("transport.npy"), s).unwrap();
     let mut m = Manifest::read(&dir).unwrap();
     let (bytes, sha256) = hash_file(&dir.join("transport.npy")).unwrap();
     m.files.push(FileRecord {

@@ -212,8 +212,7 @@ pub fn parse_dds(
     bytes: &[u8],
     enc: DenseEncoding,
 ) -> Result<(u32, u32, Vec<Vec<u8>>)> {
-    let dds =
-        Dds::read(&bytes[..]).map_err(|e| Error::input(path, format!("not a DDS file: {e}")))?;
+    let dds = Dds::read(bytes).map_err(|e| Error::input(path, format!("not a DDS file: {e}")))?;
     let ok = match enc {
         DenseEncoding::Bc1Log => {
             dds.get_d3d_format() == Some(D3DFormat::DXT1)

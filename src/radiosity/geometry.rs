@@ -360,6 +360,24 @@ impl Rng {
     }
 }
 
+/// Group key of a piece: voxel (x fastest) then axis.
+pub fn group_key(voxel: [u32; 3], axis: u8, dims: [u32; 3]) -> u64 {
+    let linear =
+        voxel[0] as u64 + dims[0] as u64 * (voxel[1] as u64 + dims[1] as u64 * voxel[2] as u64);
+    linear * 8 + axis as u64
+}
+
+/// Voxel and axis of a group key.
+pub fn split_key(key: u64, dims: [u32; 3]) -> ([u32; 3], u8) {
+    let axis = (key % 8) as u8;
+    let mut l = key / 8;
+    let x = (l % dims[0] as u64) as u32;
+    l /= dims[0] as u64;
+    let y = (l % dims[1] as u64) as u32;
+    let z = (l / dims[1] as u64) as u32;
+    ([x, y, z], axis)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -417,22 +435,4 @@ mod tests {
         k.sort();
         assert_eq!(k, (0..8).collect::<Vec<_>>());
     }
-}
-
-/// Group key of a piece: voxel (x fastest) then axis.
-pub fn group_key(voxel: [u32; 3], axis: u8, dims: [u32; 3]) -> u64 {
-    let linear =
-        voxel[0] as u64 + dims[0] as u64 * (voxel[1] as u64 + dims[1] as u64 * voxel[2] as u64);
-    linear * 8 + axis as u64
-}
-
-/// Voxel and axis of a group key.
-pub fn split_key(key: u64, dims: [u32; 3]) -> ([u32; 3], u8) {
-    let axis = (key % 8) as u8;
-    let mut l = key / 8;
-    let x = (l % dims[0] as u64) as u32;
-    l /= dims[0] as u64;
-    let y = (l % dims[1] as u64) as u32;
-    let z = (l / dims[1] as u64) as u32;
-    ([x, y, z], axis)
 }
