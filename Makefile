@@ -71,8 +71,10 @@ deps-apt:
 	fi
 
 deps-py:
-	@python3 -c "import PIL, numpy, OpenEXR, tifffile" 2>/dev/null || \
-	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) 2>&1 | grep -v "WARNING: Running pip as the 'root'" || true
+	@python3 -c "import PIL, numpy, OpenEXR, tifffile" 2>/dev/null || { \
+	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) && \
+	  python3 -c "import PIL, numpy, OpenEXR, tifffile"; } || \
+	  { echo "error: cannot install the Python cross-check readers ($(PY_PKGS))" >&2; exit 1; }
 
 fmt:
 	$(CARGO) fmt --all

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{bake, data, expect_code, list_files, python, python_with};
+use common::{bake, data, expect_code, list_files, python, require_python};
 use relume::error::exit;
 use relume::radiosity::fixtures;
 use relume::scene::Scene;
@@ -117,8 +117,7 @@ fn cornell_pipeline_exports_match_numpy() {
     ] {
         assert!(names.contains(n), "{n} missing from {names:?}");
     }
-    if !python_with(&["numpy"]) {
-        eprintln!("numpy not available: skipping the cross-check");
+    if !require_python(&["numpy"]) {
         return;
     }
     // numpy recomputes S_∞ = M (I − M)^{-1} per channel from F and the exported albedo.

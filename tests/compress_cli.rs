@@ -6,7 +6,7 @@ mod common;
 #[path = "support/transport_box.rs"]
 mod transport_box;
 
-use common::{bake, expect_code, python, python_with, text};
+use common::{bake, expect_code, python, require_python, text};
 use relume::baked::encoded::read as read_encoded;
 use relume::baked::{manifest::hash_file, FileRecord, Manifest};
 use relume::compress::{bc1, compress, gather, report, DenseEncoding, EncodeOptions};
@@ -221,8 +221,7 @@ fn dds_and_ktx2_round_trip_every_encoding() {
 
 #[test]
 fn pillow_decodes_our_dds_exactly_like_our_decoder() {
-    if !python_with(&["PIL", "numpy"]) {
-        eprintln!("SKIPPED pillow_decodes_our_dds_exactly_like_our_decoder: python3 with Pillow and numpy is missing (make deps-py)");
+    if !require_python(&["PIL", "numpy"]) {
         return;
     }
     let tmp = tempfile::tempdir().unwrap();

@@ -130,7 +130,7 @@ fn gpu_gather_matches_cpu_gather_for_every_encoding_and_path() {
     let cpu = cpu_gather(&baked, &e);
     for path in [DecodePath::Hardware, DecodePath::Shader] {
         if path == DecodePath::Hardware && !gpu.info.bc_textures {
-            eprintln!("SKIP hardware path: the adapter has no BC textures");
+            common::missing("BC texture support on the adapter (the hardware decode path)");
             continue;
         }
         let hw_bc1 = path == DecodePath::Hardware && baked.dense.encoding == DenseEncoding::Bc1Log;

@@ -1,5 +1,5 @@
 //! Every WGSL kernel against its Rust twin, on whatever adapter exists (Mesa lavapipe in CI).
-//! Without any adapter the GPU tests print a visible SKIP line; `make test` installs lavapipe.
+//! Without an adapter the GPU tests print a visible SKIP line, or fail under `CI=true` / `RELUME_REQUIRE_ALL=1`; `make test` installs lavapipe.
 
 mod common;
 

@@ -403,7 +403,7 @@ fn command_line_lights_light_the_scene_and_the_window_opens() {
         .arg("--help")
         .output();
     if xvfb.is_err() {
-        eprintln!("SKIP window test: xvfb-run not found (apt-get install xvfb xauth)");
+        common::missing("xvfb-run for the window test (apt-get install xvfb xauth)");
         return;
     }
     let o = std::process::Command::new("xvfb-run")

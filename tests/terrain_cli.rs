@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bake, data, expect_code, list_files, python, python_with};
+use common::{bake, data, expect_code, list_files, python, require_python};
 use relume::error::exit;
 use std::path::Path;
 
@@ -330,8 +330,7 @@ fn pipeline_bakes_the_mipmap_deterministically_and_openexr_reads_it() {
     let rec = m.stage("minmax_mipmap").unwrap();
     assert_eq!(rec.report["levels"], 10.0);
 
-    if !python_with(&["OpenEXR", "numpy"]) {
-        eprintln!("skipping the OpenEXR cross-check: python3 with OpenEXR and numpy not found");
+    if !require_python(&["OpenEXR", "numpy"]) {
         return;
     }
     // OpenEXR reads every part; level 0 equals the bordered 4x4 max/min of the height map

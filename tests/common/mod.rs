@@ -95,8 +95,40 @@ pub fn gpu() -> Option<relume::gpu::Gpu> {
     match relume::gpu::Gpu::new(None) {
         Ok(g) => Some(g),
         Err(e) => {
-            eprintln!("SKIP: {e}");
+            missing(&format!("a GPU adapter ({e})"));
             None
         }
     }
+}
+
+/// Must every test run? True under CI (`CI=true`, set by the CI runner) or with
+/// `RELUME_REQUIRE_ALL=1`: then a missing tool or device fails the test that needs it.
+pub fn require_all() -> bool {
+    let on = |k: &str| {
+        std::env::var(k)
+            .map(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
+            .unwrap_or(false)
+    };
+    on("CI") || on("RELUME_REQUIRE_ALL")
+}
+
+/// Something a test needs is missing (`what` says what and how to install it): fail under
+/// [`require_all`], else print a visible SKIP line and let the caller return.
+pub fn missing(what: &str) {
+    if require_all() {
+        panic!("missing {what}; CI=true (or RELUME_REQUIRE_ALL=1) requires it: `make deps` installs it");
+    }
+    eprintln!("SKIP: missing {what} (`make deps` installs it; CI fails instead of skipping)");
+}
+
+/// Python 3 with these modules for a cross-check; [`missing`] when it is not there.
+pub fn require_python(modules: &[&str]) -> bool {
+    if python_with(modules) {
+        return true;
+    }
+    missing(&format!(
+        "python3 with {} (make deps-py)",
+        modules.join(", ")
+    ));
+    false
 }
