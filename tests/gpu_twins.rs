@@ -136,47 +136,7 @@ fn read_texture(
     layer: u32,
     aspect: wgpu::TextureAspect,
 ) -> Vec<u8> {
-    let (w, h) = (t.width(), t.height());
-    let padded =
-        (w * bpp).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("texture readback"),
-        size: (padded * h) as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: t,
-            mip_level: 0,
-            origin: wgpu::Origin3d {
-                x: 0,
-                y: 0,
-                z: layer,
-            },
-            aspect,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buf,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(h),
-            },
-        },
-        wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-    );
-    gpu.queue.submit([enc.finish()]);
-    let bytes = readback::read_buffer(gpu, &buf).unwrap();
-    bytes
-        .chunks_exact(padded as usize)
-        .flat_map(|row| row[..(w * bpp) as usize].to_vec())
-        .collect()
+    readback::read_texture_layer(gpu, t, bpp, layer, aspect).unwrap()
 }
 
 #[test]

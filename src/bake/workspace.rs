@@ -30,19 +30,19 @@ pub struct Workspace {
 /// One typed slot: `get` reads it from the source bake on first use, `set` stores what a stage
 /// made.
 macro_rules! slot {
-    ($get:ident, $set:ident, $field:ident, $ty:ty, $file:expr, $read:expr) => {
-        #[doc = concat!("The `", stringify!($field), "` artifact (read from the source bake on first use).")]
+    ($get:ident, $set:ident, $ty:ty) => {
+        #[doc = concat!("The `", stringify!($get), "` artifact (`crate::baked::", stringify!($get), "`, read from the source bake on first use).")]
         pub fn $get(&mut self) -> Result<&$ty> {
-            if self.$field.is_none() {
-                let dir = self.require_source($file)?;
-                self.$field = Some($read(&dir, &self.source.as_ref().unwrap().1)?);
+            if self.$get.is_none() {
+                let dir = self.require_source(baked::$get::FILE)?;
+                self.$get = Some(baked::$get::read(&dir)?);
             }
-            Ok(self.$field.as_ref().unwrap())
+            Ok(self.$get.as_ref().unwrap())
         }
 
-        #[doc = concat!("Store the `", stringify!($field), "` artifact for later stages.")]
+        #[doc = concat!("Store the `", stringify!($get), "` artifact for later stages.")]
         pub fn $set(&mut self, value: $ty) {
-            self.$field = Some(value);
+            self.$get = Some(value);
         }
     };
 }
@@ -72,70 +72,36 @@ impl Workspace {
             .unwrap_or_else(crate::limits::default_max_memory)
     }
 
-    slot!(
-        scene,
-        set_scene,
-        scene,
-        Scene,
-        baked::scene::FILE,
-        |d: &Path, _: &Manifest| baked::scene::read(d)
-    );
-    slot!(
-        heightmap,
-        set_heightmap,
-        heightmap,
-        HeightMap,
-        baked::heightmap::FILE,
-        baked::heightmap::read
-    );
-    slot!(
-        patches,
-        set_patches,
-        patches,
-        PatchSet,
-        baked::patches::FILE,
-        |d: &Path, _: &Manifest| baked::patches::read(d)
-    );
-    slot!(
-        form_factors,
-        set_form_factors,
-        form_factors,
-        FormFactorMatrix,
-        baked::form_factors::FILE,
-        |d: &Path, _: &Manifest| baked::form_factors::read(d)
-    );
-    slot!(
-        transport,
-        set_transport,
-        transport,
-        TransportMatrix,
-        baked::transport::FILE,
-        |d: &Path, _: &Manifest| baked::transport::read(d)
-    );
-    slot!(
-        permutation,
-        set_permutation,
-        permutation,
-        Vec<u32>,
-        baked::permutation::FILE,
-        |d: &Path, _: &Manifest| baked::permutation::read(d)
-    );
-    slot!(
-        encoded,
-        set_encoded,
-        encoded,
-        EncodedTransport,
-        baked::encoded::TRANSFER_FILE,
-        |d: &Path, _: &Manifest| baked::encoded::read(d)
-    );
-    slot!(
-        mipmap,
-        set_mipmap,
-        mipmap,
-        MinMaxMipmap,
-        baked::mipmap::FILE,
-        |d: &Path, _: &Manifest| baked::mipmap::read(d)
-    );
+    slot!(scene, set_scene, Scene);
+    slot!(patches, set_patches, PatchSet);
+    slot!(form_factors, set_form_factors, FormFactorMatrix);
+    slot!(transport, set_transport, TransportMatrix);
+    slot!(permutation, set_permutation, Vec<u32>);
+    slot!(encoded, set_encoded, EncodedTransport);
+    slot!(mipmap, set_mipmap, MinMaxMipmap);
+
+    /// The height map (read from the source bake on first use; its cell size and height scale
+    /// come from the source's manifest).
+    pub fn heightmap(&mut self) -> Result<&HeightMap> {
+        if self.heightmap.is_none() {
+            let dir = self.require_source(baked::heightmap::FILE)?;
+            let manifest = &self.source.as_ref().unwrap().1;
+            self.heightmap = Some(baked::heightmap::read(&dir, manifest)?);
+        }
+        Ok(self.heightmap.as_ref().unwrap())
+    }
+
+    /// Store the height map for later stages.
+    pub fn set_heightmap(&mut self, value: HeightMap) {
+        self.heightmap = Some(value);
+    }
+
+    /// The scene and its patches together (each read on first use), for stages that need both.
+    pub fn scene_and_patches(&mut self) -> Result<(&Scene, &PatchSet)> {
+        self.scene()?;
+        self.patches()?;
+        Ok((self.scene.as_ref().unwrap(), self.patches.as_ref().unwrap()))
+    }
 
     /// Is there a permutation, made earlier in this run or in the source bake?
     pub fn has_permutation(&self) -> bool {

@@ -17,6 +17,8 @@ use std::path::Path;
 pub const SIDECAR_FILE: &str = "sidecar.bin";
 /// How to read the encoded transport (postcard [`TransferInfo`]).
 pub const TRANSFER_FILE: &str = "transfer.bin";
+/// The file whose presence marks a bake as encoded.
+pub const FILE: &str = TRANSFER_FILE;
 /// File stem of the dense texture (tiles add `_rR_cC`).
 pub const TEXTURE_STEM: &str = "transfer";
 

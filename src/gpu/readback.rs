@@ -25,9 +25,22 @@ pub fn read_f32(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<f32>> {
 
 /// Read a 2D texture with 4 bytes per texel (RGBA8 / R32F / ...) back, rows tightly packed.
 pub fn read_texture_4bpp(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<u8>> {
+    read_texture_layer(gpu, texture, 4, 0, wgpu::TextureAspect::All)
+}
+
+/// Read one array layer (one aspect) of a 2D texture with `bytes_per_texel` bytes per texel
+/// back, rows tightly packed.
+pub fn read_texture_layer(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    bytes_per_texel: u32,
+    layer: u32,
+    aspect: wgpu::TextureAspect,
+) -> Result<Vec<u8>> {
     let (w, h) = (texture.width(), texture.height());
+    let row = w * bytes_per_texel;
     let padded =
-        (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("texture readback"),
         size: padded as u64 * h as u64,
@@ -36,7 +49,16 @@ pub fn read_texture_4bpp(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<u8>> 
     });
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     enc.copy_texture_to_buffer(
-        texture.as_image_copy(),
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d {
+                x: 0,
+                y: 0,
+                z: layer,
+            },
+            aspect,
+        },
         wgpu::TexelCopyBufferInfo {
             buffer: &staging,
             layout: wgpu::TexelCopyBufferLayout {
@@ -53,9 +75,9 @@ pub fn read_texture_4bpp(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<u8>> 
     );
     gpu.queue.submit([enc.finish()]);
     let bytes = map_and_copy(gpu, &staging)?;
-    let mut out = Vec::with_capacity((w * h * 4) as usize);
-    for row in bytes.chunks_exact(padded as usize) {
-        out.extend_from_slice(&row[..(w * 4) as usize]);
+    let mut out = Vec::with_capacity((row * h) as usize);
+    for r in bytes.chunks_exact(padded as usize) {
+        out.extend_from_slice(&r[..row as usize]);
     }
     Ok(out)
 }

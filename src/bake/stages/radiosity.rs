@@ -96,16 +96,17 @@ impl StageRun for FormFactorsKnobs {
         txn: &mut BakeTransaction,
         progress: &dyn Progress,
     ) -> Result<StageRecord> {
-        let set = ws.patches()?.clone();
+        let budget = ws.memory_budget();
+        let (scene, set) = ws.scene_and_patches()?;
         let n = set.len();
         let n2 = (n * n) as u64;
         crate::limits::check_memory(
             &format!("the form factors of {n} patches"),
             n2 * 4 * 3,
-            ws.memory_budget(),
+            budget,
         )?;
         let samples = self.samples();
-        let f = form_factors(ws.scene()?, &set, &self.params(), progress)?;
+        let f = form_factors(scene, set, &self.params(), progress)?;
         let sums: Vec<f64> = (0..n).map(|i| f.row_sum(i)).collect();
         let matrix = FormFactorMatrix {
             n,
