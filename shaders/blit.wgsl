@@ -1,5 +1,5 @@
 // Copies the player's RGBA8 target onto the window's surface (any format) texel for texel.
-// Rust twin: the identity (tests compare the surface-sized copy with the source).
+// Rust twin: relume::gpu::blit::blit_reference (tests/gpu_twins_raster.rs compares them texel by texel).
 
 @group(0) @binding(0) var source: texture_2d<f32>;
 

@@ -32,7 +32,7 @@ impl DecodePath {
 }
 
 /// The `GatherParams` uniform of `gather_compressed.wgsl` (public for the layout test in
-/// tests/gpu_twins.rs).
+/// tests/gpu_layout.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Params {

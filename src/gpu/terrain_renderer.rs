@@ -14,7 +14,7 @@ use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 /// The `TerrainParams` uniform of `terrain_shadow.wgsl` (public for the layout test in
-/// tests/gpu_twins.rs).
+/// tests/gpu_layout.rs).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TerrainParams {
@@ -46,7 +46,7 @@ pub struct TerrainParams {
 }
 
 /// The `TerrainFrame` uniform of `terrain_render.wgsl` (public for the layout test in
-/// tests/gpu_twins.rs).
+/// tests/gpu_layout.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TerrainFrame {
