@@ -153,7 +153,8 @@ pub mod arg {
             };
         }
         match t.parse::<u32>() {
-            Ok(k) => super::bounces(Bounces::Finite(k)),
+            Ok(0) => Err("out of range: 0 (at least one bounce; `inf` for all)".into()),
+            Ok(k) => Ok(Bounces::Finite(k)),
             _ => Err(format!(
                 "`{s}` is not a bounce count (k ≥ 1, `inf` or `auto:TOL`)"
             )),

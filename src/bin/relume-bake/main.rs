@@ -59,7 +59,7 @@ enum Command {
         #[arg(short, long, value_name = "DIR")]
         out: Option<PathBuf>,
         /// Refuse to start when the estimated peak memory exceeds this (e.g. 512M, 8G; default 75% of RAM)
-        #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+        #[arg(long, value_name = "SIZE", value_parser = relume::limits::parse_bytes)]
         max_memory: Option<u64>,
     },
     /// Show the stages a pipeline would run, with estimated peak memory and output size; writes nothing
@@ -137,10 +137,6 @@ impl LoadKnobs {
             downsample: self.downsample.unwrap_or(d.downsample),
         }
     }
-}
-
-fn parse_size(s: &str) -> std::result::Result<u64, String> {
-    relume::limits::parse_bytes(s)
 }
 
 fn main() {
