@@ -11,7 +11,7 @@ export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
 
-.PHONY: all build demo test deps deps-apt deps-py fmt lint bench study ci clean
+.PHONY: all build demo docs-images test deps deps-apt deps-py fmt lint bench study ci clean
 
 all: build
 
@@ -52,6 +52,40 @@ demo: build
 	@echo "  puget-sound-frames/frame_000[0-1].png          player: Puget Sound 2K, hard relief shadows"
 	@echo "  puget-sound-soft-frames/frame_0000.png         player: Puget Sound 2K, soft shadows"
 	@echo "  */frames.json                                  adapter and per-pass frame times"
+
+## Every image the README and docs/ show, regenerated from the code into docs/images/ (player
+## frames on the machine's GPU or Mesa lavapipe, terrain images, study plots). Deterministic for
+## the same machine and software, except the time axes of the plots. About a minute after the build.
+DOCS_OUT := out/docs-images
+docs-images: build
+	@rm -rf $(DOCS_OUT) && mkdir -p $(DOCS_OUT) docs/images && mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
+	$(BAKE) -q run pipelines/cornell.ron --out $(DOCS_OUT)/cornell
+	$(BAKE) -q run pipelines/gltf-room.ron --out $(DOCS_OUT)/gltf-room
+	$(BAKE) -q run pipelines/puget-sound-2k.ron --out $(DOCS_OUT)/puget-sound-2k
+	$(PLAYER) $(DOCS_OUT)/cornell --headless -q --size 480x360 --exposure 2 --out $(DOCS_OUT)/cornell-frames
+	$(PLAYER) $(DOCS_OUT)/cornell --headless -q --size 480x360 --sun 20,30 --frames 4 --out $(DOCS_OUT)/cornell-sun-frames
+	$(PLAYER) $(DOCS_OUT)/gltf-room --headless -q --size 480x360 --exposure 2 \
+	    --camera 1.8,1.9,2.6,0,0.3,0,45 --out $(DOCS_OUT)/gltf-room-frames
+	$(PLAYER) $(DOCS_OUT)/puget-sound-2k --headless -q --size 400x250 --sun 300,6 --out $(DOCS_OUT)/terrain-frames
+	$(BAKE) -q shadow pipelines/puget-sound-512.ron --sun-azimuth 300 --sun-elevation 10 \
+	    --out docs/images/puget-sound-shadow.png --shaded docs/images/puget-sound-relief.png
+	$(BAKE) -q softshadow pipelines/puget-sound-512.ron --sun-azimuth 300 --sun-elevation 3 \
+	    --out docs/images/puget-sound-soft-lit.png
+	cp $(DOCS_OUT)/cornell-frames/frame_0000.png docs/images/cornell.png
+	cp $(DOCS_OUT)/cornell-sun-frames/frame_0001.png docs/images/cornell-sun.png
+	cp $(DOCS_OUT)/gltf-room-frames/frame_0000.png docs/images/gltf-room.png
+	cp $(DOCS_OUT)/terrain-frames/frame_0000.png docs/images/puget-sound-player.png
+	$(BAKE) -q study radiosity --out $(DOCS_OUT)/study/radiosity
+	$(BAKE) -q study compression --out $(DOCS_OUT)/study/compression
+	$(BAKE) -q study terrain --sizes 512,1024,2048 --elevations 5,30 --soft-elevations 2,5 \
+	    --soft-rows 64 --out $(DOCS_OUT)/study/terrain
+	for f in radiosity/radiosity_patches_error_vs_time radiosity/radiosity_estimator_error_vs_time \
+	         radiosity/radiosity_bounces_error_vs_time compression/compression_reorder_error_vs_time \
+	         compression/compression_encoding_error_vs_bytes terrain/terrain_hard_shadows_time_vs_pixels \
+	         terrain/terrain_soft_shadows_error_vs_time; do \
+	  cp $(DOCS_OUT)/study/$$f.png docs/images/study-$$(basename $$f | tr _ -).png || exit 1; \
+	done
+	@du -ch docs/images/*.png | tail -1
 
 ## Install what the tests need (software Vulkan, Python cross-check readers), then run them all.
 test: deps

@@ -181,6 +181,23 @@ fn radiosity_quick_sweeps_patches_estimators_and_bounces() {
         g("k = inf")
     );
     assert!(g("auto 1e-3") < g("k = 8"));
+
+    // The settings marked as relume's default are exactly those of the knob defaults
+    // (hemisphere 4096 rays; infinite bounces; the quick patch sweep does not reach 1000).
+    let defaults = |s: &Value| -> Vec<String> {
+        s["settings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|x| x["default"] == true)
+            .map(|x| x["label"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(defaults(p), Vec::<String>::new());
+    assert_eq!(defaults(e), ["hemisphere 4096"]);
+    assert_eq!(defaults(b), ["k = inf"]);
+    let md = std::fs::read_to_string(dir.path().join("out/study.md")).unwrap();
+    assert_eq!(md.matches("◀ default").count(), 2, "{md}");
 }
 
 #[test]

@@ -17,6 +17,7 @@ use crate::compress::{
     ReorderOptions,
 };
 use crate::error::Result;
+use crate::pipeline::knobs::{EncodeKnobs, ReorderKnobs};
 use crate::progress::Progress;
 use crate::radiosity::formfactor::FormFactorParams;
 use crate::radiosity::transport::Bounces;
@@ -269,7 +270,9 @@ pub fn run(
         } else {
             format!("{metric:?}")
         };
+        let d = ReorderKnobs::default();
         let mut st = Setting::new(label, series)
+            .default_if(p == d.passes && (p == 0 || metric == d.metric))
             .knob("passes", p)
             .knob("metric", format!("{metric:?}"))
             .knob("encoding", DenseEncoding::Bc1Log.name())
@@ -333,7 +336,12 @@ pub fn run(
         }
     }
     let seed_label = "seed: bc1_log p=4 zeroed holes".to_string();
-    rows.push((seed_label.clone(), "seed".into(), 4.0, seed_options()));
+    rows.push((
+        seed_label.clone(),
+        "radiosity thesis".into(),
+        4.0,
+        seed_options(),
+    ));
     let mut enc_sweep = Sweep {
         name: "compression_encoding".into(),
         title: "Compression: encoding and split".into(),
@@ -378,7 +386,15 @@ pub fn run(
     for (label, series, p, o) in rows {
         let (enc, enc_secs) = timed(|| compress(&sp, perm.clone(), p, &o));
         let enc = enc?;
+        let d = EncodeKnobs::default();
         let mut st = Setting::new(label, series)
+            .default_if(
+                o.encoding == d.encoding
+                    && p == d.split_percent
+                    && o.fill_holes == d.fill_holes
+                    && o.feedback == d.feedback
+                    && o.log_range == d.log_range,
+            )
             .knob("encoding", o.encoding.name())
             .knob("split_percent", p)
             .knob("fill_holes", o.fill_holes)

@@ -116,6 +116,9 @@ pub struct Setting {
     pub knobs: BTreeMap<String, serde_json::Value>,
     /// This setting is the sweep's reference (its errors are 0 by construction).
     pub reference: bool,
+    /// This setting is what relume does by default (the knob defaults of `pipeline::knobs` or
+    /// the command's default method): marked in tables and ringed in plots.
+    pub default: bool,
     /// Label of the setting its ratios are taken against, when not the sweep's baseline.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub baseline: Option<String>,
@@ -136,6 +139,12 @@ impl Setting {
             series: series.into(),
             ..Default::default()
         }
+    }
+
+    /// Mark this setting as relume's default when `is_default`.
+    pub fn default_if(mut self, is_default: bool) -> Self {
+        self.default = is_default;
+        self
     }
 
     /// Add a knob value.

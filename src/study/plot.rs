@@ -84,6 +84,7 @@ const FONT: &[(char, [u8; 7])] = &[
     ('=', [0, 0, 0x1F, 0, 0x1F, 0, 0]),
     ('^', [0x04, 0x0A, 0x11, 0, 0, 0, 0]),
     ('°', [0x0C, 0x12, 0x12, 0x0C, 0, 0, 0]),
+    ('|', [0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04]),
     ('?', [0x0E, 0x11, 0x01, 0x02, 0x04, 0, 0x04]),
 ];
 
@@ -226,8 +227,13 @@ fn tick_label(v: f64) -> String {
     }
 }
 
-/// (x, y, setting label).
-type Point = (f64, f64, String);
+/// A plotted setting: x, y (0 = exact: drawn on the bottom edge), label, relume's default?
+struct Point {
+    x: f64,
+    y: f64,
+    label: String,
+    default: bool,
+}
 
 /// Draw one plot of `sweep`.
 pub fn draw(spec: &PlotSpec, sweep: &Sweep) -> RgbImage {
@@ -239,20 +245,38 @@ pub fn draw(spec: &PlotSpec, sweep: &Sweep) -> RgbImage {
     let mut skipped = 0;
     for s in &sweep.settings {
         match (s.value(&spec.x), s.value(&spec.y)) {
-            (Some(x), Some(y)) if x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite() => {
+            // An error of exactly 0 has no place on a log axis: it sits on the bottom edge.
+            (Some(x), Some(y)) if x > 0.0 && y >= 0.0 && x.is_finite() && y.is_finite() => {
+                let p = Point {
+                    x,
+                    y,
+                    label: s.label.clone(),
+                    default: s.default,
+                };
                 match series.iter_mut().find(|e| e.0 == s.series) {
-                    Some(e) => e.1.push((x, y, s.label.clone())),
-                    None => series.push((s.series.clone(), vec![(x, y, s.label.clone())])),
+                    Some(e) => e.1.push(p),
+                    None => series.push((s.series.clone(), vec![p])),
                 }
             }
             _ => skipped += 1,
         }
     }
     let all = || series.iter().flat_map(|s| s.1.iter());
-    let ax = Axis::covering(all().map(|p| p.0));
-    let ay = Axis::covering(all().map(|p| p.1));
+    let exact = all().filter(|p| p.y == 0.0).count();
+    let any_default = all().any(|p| p.default);
+    let ax = Axis::covering(all().map(|p| p.x));
+    let ay = Axis::covering(all().map(|p| p.y).filter(|&y| y > 0.0));
     let px = |v: f64| x0 + (ax.at(v) * (x1 - x0) as f64).round() as i64;
-    let py = |v: f64| y1 - (ay.at(v) * (y1 - y0) as f64).round() as i64;
+    // Settings with error 0 get their own row under the log axis, labelled 0.
+    let zero_row = if exact > 0 { 24 } else { 0 };
+    let yl = y1 - zero_row;
+    let py = |v: f64| {
+        if v > 0.0 {
+            yl - (ay.at(v) * (yl - y0) as f64).round() as i64
+        } else {
+            y1 - zero_row / 2
+        }
+    };
     for (v, labelled) in ax.ticks() {
         let x = px(v);
         line(
@@ -279,6 +303,17 @@ pub fn draw(spec: &PlotSpec, sweep: &Sweep) -> RgbImage {
             draw_text(&mut img, x0 - 8 - text_width(&t, 1), y - 3, &t, 1, BLACK);
         }
     }
+    if exact > 0 {
+        line(&mut img, (x0, yl + 4), (x1, yl + 4), BLACK);
+        draw_text(
+            &mut img,
+            x0 - 8 - text_width("0", 1),
+            py(0.0) - 3,
+            "0",
+            1,
+            BLACK,
+        );
+    }
     // Frame.
     for (a, b) in [
         ((x0, y0), (x1, y0)),
@@ -291,19 +326,24 @@ pub fn draw(spec: &PlotSpec, sweep: &Sweep) -> RgbImage {
     let label_points = all().count() <= 12;
     for (k, (name, points)) in series.iter_mut().enumerate() {
         let c = Rgb(PALETTE[k % PALETTE.len()]);
-        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        points.sort_by(|a, b| a.x.total_cmp(&b.x));
         for pair in points.windows(2) {
             line(
                 &mut img,
-                (px(pair[0].0), py(pair[0].1)),
-                (px(pair[1].0), py(pair[1].1)),
+                (px(pair[0].x), py(pair[0].y)),
+                (px(pair[1].x), py(pair[1].y)),
                 c,
             );
         }
-        for (x, y, label) in points.iter() {
-            fill_rect(&mut img, px(*x) - 3, py(*y) - 3, 7, 7, c);
+        for p in points.iter() {
+            let (x, y) = (px(p.x), py(p.y));
+            fill_rect(&mut img, x - 3, y - 3, 7, 7, c);
+            if p.default {
+                ring(&mut img, x, y, 7, BLACK);
+                ring(&mut img, x, y, 8, BLACK);
+            }
             if label_points {
-                draw_text(&mut img, px(*x) + 6, py(*y) - 12, label, 1, c);
+                draw_text(&mut img, x + 6, y - 12, &p.label, 1, c);
             }
         }
         // Legend.
@@ -329,12 +369,39 @@ pub fn draw(spec: &PlotSpec, sweep: &Sweep) -> RgbImage {
         1,
         BLACK,
     );
+    if any_default {
+        let ly = y0 + 10 + 16 * series.len() as i64 + 8;
+        ring(&mut img, x1 + 21, ly + 3, 6, BLACK);
+        draw_text(&mut img, x1 + 32, ly, "relume default", 1, BLACK);
+    }
+    let mut notes = Vec::new();
+    if exact > 0 {
+        notes.push(format!(
+            "{exact} setting(s) with error 0 (exact) in the bottom row"
+        ));
+    }
     if skipped > 0 {
-        let note =
-            format!("{skipped} setting(s) not shown: zero or missing value (e.g. the reference)");
-        draw_text(&mut img, LEFT, h - 20, &note, 1, Rgb([90, 90, 90]));
+        notes.push(format!("{skipped} setting(s) not shown: no value"));
+    }
+    if !notes.is_empty() {
+        draw_text(
+            &mut img,
+            LEFT,
+            h - 20,
+            &notes.join("; "),
+            1,
+            Rgb([90, 90, 90]),
+        );
     }
     img
+}
+
+/// A square outline of half-side `r` around (x, y).
+fn ring(img: &mut RgbImage, x: i64, y: i64, r: i64, c: Rgb<u8>) {
+    line(img, (x - r, y - r), (x + r, y - r), c);
+    line(img, (x + r, y - r), (x + r, y + r), c);
+    line(img, (x + r, y + r), (x - r, y + r), c);
+    line(img, (x - r, y + r), (x - r, y - r), c);
 }
 
 #[cfg(test)]
@@ -351,6 +418,61 @@ mod tests {
         assert_eq!(tick_label(0.002), "2e-3");
         assert_eq!(tick_label(100.0), "100");
         assert_eq!(tick_label(5.0), "5");
+    }
+
+    #[test]
+    fn the_default_is_ringed_and_exact_settings_get_the_zero_row() {
+        use crate::study::{ErrorStats, Measure, Setting};
+        let point = |label: &str, secs: f64, err: f64, default: bool| {
+            let mut s = Setting::new(label, "a").default_if(default);
+            s.seconds = secs;
+            s.errors
+                .insert("e".into(), ErrorStats::of(&[err], &[0.0], None));
+            s
+        };
+        let spec = PlotSpec {
+            file: "p.png".into(),
+            title: "t".into(),
+            x: Measure::Seconds,
+            y: Measure::Error("e".into(), "mean".into()),
+            x_label: "s".into(),
+            y_label: "e".into(),
+        };
+        let sweep = |d: bool| Sweep {
+            settings: vec![
+                point("a", 0.01, 0.1, false),
+                point("b", 0.1, 0.01, d),
+                point("c", 1.0, 0.0, false),
+            ],
+            ..Default::default()
+        };
+        let (plain, ringed) = (draw(&spec, &sweep(false)), draw(&spec, &sweep(true)));
+        // Only the ring (and the legend's "relume default" entry) differ.
+        let differing: Vec<(u32, u32)> = plain
+            .enumerate_pixels()
+            .filter(|(x, y, p)| ringed.get_pixel(*x, *y) != *p)
+            .map(|(x, y, _)| (x, y))
+            .collect();
+        assert!(!differing.is_empty());
+        let in_plot: Vec<_> = differing
+            .iter()
+            .filter(|(x, _)| (*x as i64) < WIDTH as i64 - RIGHT)
+            .collect();
+        assert!(!in_plot.is_empty(), "the ring is drawn");
+        // All inside a small box around point b (x = 0.1 s, the middle of the 1e-2..1 axis;
+        // y = 1e-2, the bottom of the log axis, above the zero row).
+        let cx = LEFT + (WIDTH as i64 - RIGHT - LEFT) / 2;
+        let cy = HEIGHT as i64 - BOTTOM - 24;
+        for (x, y) in in_plot {
+            assert!(
+                (*x as i64 - cx).abs() <= 12 && (*y as i64 - cy).abs() <= 12,
+                "ring pixel at ({x}, {y}), point at ({cx}, {cy})"
+            );
+        }
+        // The exact setting c sits in the zero row: its colour appears right above the frame.
+        let row = HEIGHT as i64 - BOTTOM - 12;
+        let cx = WIDTH as i64 - RIGHT;
+        assert_eq!(*plain.get_pixel(cx as u32 - 1, row as u32), Rgb(PALETTE[0]));
     }
 
     #[test]

@@ -18,6 +18,7 @@ use super::timing::timed;
 use super::{Column, ErrorStats, Format, Measure, Setting, Sweep};
 use crate::error::Result;
 use crate::limits::default_max_memory;
+use crate::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
 use crate::progress::{Progress, Silent};
 use crate::radiosity::formfactor::{form_factors, Estimator, FormFactorParams, FormFactors};
 use crate::radiosity::geometry::dominant_axis;
@@ -54,7 +55,7 @@ impl RadiosityConfig {
     /// The full study (minutes on 2 cores for the Cornell box).
     pub fn full() -> Self {
         RadiosityConfig {
-            patch_targets: vec![150, 600, 2400],
+            patch_targets: vec![150, 600, 1000, 2400],
             patch_sweep_samples: 2048,
             fixed_patches: 600,
             hemisphere_samples: vec![256, 1024, 4096],
@@ -261,6 +262,7 @@ pub fn patch_sweep(scene: &Scene, cfg: &RadiosityConfig, progress: &dyn Progress
         }
         let weights = [w.clone(), w.clone(), w].concat();
         let mut s = Setting::new(format!("target {t}"), "hemisphere")
+            .default_if(VoxelizeKnobs::default().resolution == Resolution::TargetPatches(*t))
             .knob("target_patches", *t)
             .knob("estimator", "Hemisphere")
             .knob("samples", cfg.patch_sweep_samples)
@@ -363,7 +365,9 @@ pub fn estimator_sweep(
     };
     for (estimator, samples, is_ref, f, secs, t_secs, light) in &measured {
         let name = format!("{estimator:?}").to_lowercase();
+        let ff = FormFactorsKnobs::default();
         let mut s = Setting::new(format!("{name} {samples}"), name.clone())
+            .default_if(*estimator == ff.estimator && *samples == ff.samples())
             .knob("estimator", format!("{estimator:?}"))
             .knob("samples", *samples)
             .knob("target_patches", cfg.fixed_patches)
@@ -469,7 +473,9 @@ pub fn bounce_sweep(
             Bounces::Infinite => ("k = inf".to_string(), "infinite"),
             Bounces::Auto(tol) => (format!("auto {tol:e}"), "auto"),
         };
-        let mut s = Setting::new(label, series).knob("bounces", format!("{b:?}"));
+        let mut s = Setting::new(label, series)
+            .default_if(b == TransportKnobs::default().bounces)
+            .knob("bounces", format!("{b:?}"));
         s.errors.insert(
             "gathered_light".into(),
             ErrorStats::of(&light, &reference, Some(&weights)),

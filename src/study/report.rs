@@ -101,13 +101,17 @@ pub fn format_ratio(v: Option<f64>, base: Option<f64>) -> String {
 
 fn row(sweep: &Sweep, s: &Setting, columns: &[Column]) -> String {
     let base = sweep.baseline_of(s);
-    let mut cells = vec![if s.reference {
+    let mut cell = if s.reference {
         format!("**{}** (reference)", s.label)
     } else if base.is_some_and(|b| b.label == s.label) {
         format!("{} (baseline)", s.label)
     } else {
         s.label.clone()
-    }];
+    };
+    if s.default {
+        cell.push_str(" ◀ default");
+    }
+    let mut cells = vec![cell];
     for c in columns {
         let v = s.value(&c.measure);
         cells.push(format_value(v, c.format));

@@ -116,6 +116,7 @@ pub fn soft_shadow_sweep(
                     reference = lit.clone();
                 }
                 let mut s = Setting::new(label(m), m.label())
+                    .default_if(*m == SoftShadowParams::default().method)
                     .knob("width", w)
                     .knob("height", h)
                     .knob("sun_elevation", el)

@@ -148,6 +148,7 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
             ] {
                 let name = format!("{method:?}").to_lowercase();
                 let mut s = Setting::new(format!("{size} {el}° {name}"), format!("{name} {el}°"))
+                    .default_if(method == HardMethod::default())
                     .knob("width", m.width)
                     .knob("height", m.height)
                     .knob("sun_elevation", el)
