@@ -94,7 +94,14 @@ fn main() {
         (2, ReorderMetric::Log),
     ] {
         let t = Instant::now();
-        let perm = reorder(&ctx.s, ReorderOptions { passes, metric });
+        let perm = reorder(
+            &mut ctx.s.clone(),
+            ReorderOptions {
+                passes,
+                metric,
+                ..Default::default()
+            },
+        );
         let secs = t.elapsed().as_secs_f64();
         let sp = ctx.s.permuted(&perm);
         let enc = compress(&sp, perm.clone(), 4.0, &EncodeOptions::default()).unwrap();

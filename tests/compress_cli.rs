@@ -362,10 +362,11 @@ fn two_reorder_passes_do_not_increase_the_summed_error_on_the_cornell_box() {
     let mut sums = Vec::new();
     for passes in 0..=2 {
         let perm = reorder(
-            &s,
+            &mut s.clone(),
             ReorderOptions {
                 passes,
                 metric: ReorderMetric::Linear,
+                ..Default::default()
             },
         );
         let sp = s.permuted(&perm);

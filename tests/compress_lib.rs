@@ -221,10 +221,11 @@ fn gather_from_permuted_compressed_matrix_is_within_the_reported_error() {
     let s = transport_box::transport(&scene, Some(3));
     let n = s.n;
     let perm = reorder(
-        &s,
+        &mut s.clone(),
         ReorderOptions {
             passes: 2,
             metric: ReorderMetric::Linear,
+            ..Default::default()
         },
     );
     assert!(is_permutation(&perm));
@@ -260,10 +261,11 @@ fn two_reorder_passes_do_not_increase_the_summed_error() {
     let mut sums = Vec::new();
     for passes in 0..=2 {
         let perm = reorder(
-            &s,
+            &mut s.clone(),
             ReorderOptions {
                 passes,
                 metric: ReorderMetric::Linear,
+                ..Default::default()
             },
         );
         let sp = s.permuted(&perm);
@@ -284,10 +286,11 @@ fn encoding_is_deterministic_across_thread_counts() {
             .unwrap();
         pool.install(|| {
             let perm = reorder(
-                &s,
+                &mut s.clone(),
                 ReorderOptions {
                     passes: 2,
                     metric: ReorderMetric::Log,
+                    ..Default::default()
                 },
             );
             let sp = s.permuted(&perm);
@@ -315,7 +318,11 @@ proptest! {
     #[test]
     fn permutation_is_a_bijection_and_s_prime_is_p_s_pt(s in matrix_strategy(), passes in 0u8..=2, log in any::<bool>()) {
         let metric = if log { ReorderMetric::Log } else { ReorderMetric::Linear };
-        let perm = reorder(&s, ReorderOptions { passes, metric });
+        let perm = reorder(&mut s.clone(), ReorderOptions {
+            passes,
+            metric,
+            ..Default::default()
+        });
         prop_assert!(is_permutation(&perm));
         prop_assert_eq!(perm.len(), s.n);
         let sp = s.permuted(&perm);

@@ -146,10 +146,11 @@ fn gpu_gather_matches_cpu_gather_for_every_encoding_and_path() {
     let grey = TransportMatrix::new(1, s.n, s.data[s.n * s.n..2 * s.n * s.n].to_vec()).unwrap();
     for m in [&s, &grey] {
         let perm = reorder(
-            m,
+            &mut m.clone(),
             ReorderOptions {
                 passes: 2,
                 metric: relume::compress::ReorderMetric::Linear,
+                ..Default::default()
             },
         );
         let sp = m.permuted(&perm);

@@ -213,9 +213,23 @@ fn compression_quick_sweeps_reorder_split_and_encodings() {
             "1 passes Linear",
             "1 passes Log",
             "2 passes Linear",
-            "2 passes Log"
+            "2 passes Log",
+            "1 passes Linear bounded",
+            "2 passes Linear bounded"
         ]
     );
+    // The bounded walk finds the thesis's greedy order: the same errors as the full one.
+    for p in ["1", "2"] {
+        let (f, b) = (
+            setting(r, &format!("{p} passes Linear")),
+            setting(r, &format!("{p} passes Linear bounded")),
+        );
+        assert_eq!(
+            err(f, "matrix", "sum"),
+            err(b, "matrix", "sum"),
+            "{p} passes"
+        );
+    }
     for s in settings(r) {
         // The radiosity thesis's three numbers are all there.
         for m in ["mean", "max", "sum"] {

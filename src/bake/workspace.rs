@@ -91,6 +91,12 @@ impl Workspace {
         Ok(self.heightmap.as_ref().unwrap())
     }
 
+    /// The transport, to be changed in place and restored (the bounded reorder transposes it).
+    pub fn transport_mut(&mut self) -> Result<&mut TransportMatrix> {
+        self.transport()?;
+        Ok(self.transport.as_mut().unwrap())
+    }
+
     /// Store the height map for later stages.
     pub fn set_heightmap(&mut self, value: HeightMap) {
         self.heightmap = Some(value);

@@ -30,6 +30,7 @@ pub mod encode;
 pub mod gather;
 pub mod logmap;
 pub mod reorder;
+pub mod reorder_bounded;
 pub mod report;
 pub mod split;
 
@@ -38,7 +39,7 @@ use crate::radiosity::TransportMatrix;
 
 pub use dense::{DenseEncoding, DenseTexture, EncodeOptions};
 pub use gather::gather;
-pub use reorder::{reorder, ReorderMetric, ReorderOptions};
+pub use reorder::{reorder, ReorderMethod, ReorderMetric, ReorderOptions};
 pub use split::{split_top, Sidecar};
 
 /// A compressed transport: permutation, dense texture and sidecar (all in permuted order).

@@ -31,12 +31,27 @@ pub enum ReorderMetric {
     Log,
 }
 
+/// How a greedy pass finds each next row: both give the thesis's greedy order.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
+)]
+pub enum ReorderMethod {
+    /// The thesis's: all n²/2 pairwise distances (O(channels·n³), an n×n matrix and copies of S).
+    Full,
+    /// The same walk with signature lower bounds ([`super::reorder_bounded`]): no distance
+    /// matrix, no copy of S (the columns pass transposes S in place and back). `Linear` only;
+    /// with `Log` the pass falls back to `Full`.
+    #[default]
+    Bounded,
+}
+
 /// Knobs of [`reorder`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ReorderOptions {
     /// 0 (identity), 1 (rows) or 2 (rows, then columns).
     pub passes: u8,
     pub metric: ReorderMetric,
+    pub method: ReorderMethod,
 }
 
 /// Which vectors a pass compares.
@@ -47,8 +62,42 @@ pub enum Axis {
 }
 
 /// The permutation (`perm[k]` = original index at position `k`) after `opts.passes` greedy
-/// passes (rows first, then columns). Deterministic for any thread count.
-pub fn reorder(m: &TransportMatrix, opts: ReorderOptions) -> Vec<u32> {
+/// passes (rows first, then columns). Deterministic for any thread count. With
+/// [`ReorderMethod::Bounded`] (and `Linear`) `m` is transposed in place during the columns pass
+/// and restored, bit for bit, before this returns.
+pub fn reorder(m: &mut TransportMatrix, opts: ReorderOptions) -> Vec<u32> {
+    if opts.method == ReorderMethod::Bounded && opts.metric == ReorderMetric::Linear {
+        return bounded(m, opts.passes.min(2));
+    }
+    full(m, opts)
+}
+
+fn bounded(m: &mut TransportMatrix, passes: u8) -> Vec<u32> {
+    use super::reorder_bounded::{
+        bounded_walk, permute_rows_in_place, transpose_in_place, Vectors,
+    };
+    let mut perm: Vec<u32> = (0..m.n as u32).collect();
+    if passes >= 1 {
+        perm = bounded_walk(&Vectors { m, order: None });
+    }
+    if passes >= 2 {
+        // Columns of P S Pᵀ = rows of (P S)ᵀ, picked in the order perm: permute S's rows and
+        // transpose, in place; undo both afterwards (pure moves: S comes back bit for bit).
+        permute_rows_in_place(m, &perm, false);
+        transpose_in_place(m);
+        let order = bounded_walk(&Vectors {
+            m,
+            order: Some(&perm),
+        });
+        transpose_in_place(m);
+        permute_rows_in_place(m, &perm, true);
+        perm = order.iter().map(|&k| perm[k as usize]).collect();
+    }
+    perm
+}
+
+/// The thesis's passes over the full distance matrix.
+fn full(m: &TransportMatrix, opts: ReorderOptions) -> Vec<u32> {
     let mut perm: Vec<u32> = (0..m.n as u32).collect();
     let mut current: Option<TransportMatrix> = None;
     for pass in 0..opts.passes.min(2) {
@@ -111,7 +160,8 @@ fn channel_max(v: &[f32]) -> f32 {
 }
 
 const TILE: usize = 64;
-const KCHUNK: usize = 512;
+/// Coordinates per chunk of a distance (cache blocking; part of the summation order).
+pub const KCHUNK: usize = 512;
 
 /// All pairwise L1 distances between the `n` vectors of length `d` in `x` (n×n, symmetric,
 /// zero diagonal). Blocked: tiles of 64×64 pairs over chunks of 512 coordinates, so both tiles'
@@ -139,6 +189,7 @@ pub fn pairwise_l1(x: &[f32], n: usize, d: usize) -> Vec<f32> {
                 }
                 k0 = k1;
             }
+            // (Each entry is `l1_chunked` of its pair: the same chunks, in the same order.)
             acc
         })
         .collect();
@@ -157,9 +208,19 @@ pub fn pairwise_l1(x: &[f32], n: usize, d: usize) -> Vec<f32> {
     dist
 }
 
+/// The L1 distance of two whole vectors exactly as [`pairwise_l1`] sums it: chunks of
+/// `KCHUNK` coordinates, each by [`l1`], added in order.
+pub fn l1_chunked(a: &[f32], b: &[f32]) -> f32 {
+    let mut acc = 0.0f32;
+    for (ca, cb) in a.chunks(KCHUNK).zip(b.chunks(KCHUNK)) {
+        acc += l1(ca, cb);
+    }
+    acc
+}
+
 /// Sum of absolute differences with eight accumulators (vectorises).
 #[inline]
-fn l1(a: &[f32], b: &[f32]) -> f32 {
+pub fn l1(a: &[f32], b: &[f32]) -> f32 {
     let mut acc = [0.0f32; 8];
     let ca = a.chunks_exact(8);
     let cb = b.chunks_exact(8);

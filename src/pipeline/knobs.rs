@@ -6,7 +6,7 @@
 use super::checks;
 use crate::compress::containers::Container;
 use crate::compress::dense::{DenseEncoding, EncodeOptions};
-use crate::compress::reorder::{ReorderMetric, ReorderOptions};
+use crate::compress::reorder::{ReorderMethod, ReorderMetric, ReorderOptions};
 use crate::radiosity::formfactor::{Estimator, FormFactorParams};
 use crate::radiosity::transport::{Bounces, Power};
 use crate::radiosity::voxelize::{Resolution, VoxelizeParams};
@@ -116,6 +116,10 @@ pub struct ReorderKnobs {
     /// sees; measured no better, see docs/compression.md).
     #[serde(default = "default_metric")]
     pub metric: ReorderMetric,
+    /// `Bounded` (default: the thesis's greedy order found with lower bounds, near O(n²)) or
+    /// `Full` (the thesis's all-pairs distance matrix, O(n³)): the same permutation.
+    #[serde(default)]
+    pub method: ReorderMethod,
 }
 
 fn default_passes() -> u8 {
@@ -130,6 +134,7 @@ impl Default for ReorderKnobs {
         ReorderKnobs {
             passes: default_passes(),
             metric: default_metric(),
+            method: ReorderMethod::default(),
         }
     }
 }
@@ -257,6 +262,7 @@ impl ReorderKnobs {
         ReorderOptions {
             passes: self.passes,
             metric: self.metric,
+            method: self.method,
         }
     }
 }

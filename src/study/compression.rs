@@ -13,8 +13,8 @@ use super::timing::{median_secs, timed};
 use super::{relative, Column, ErrorStats, Format, Measure, Setting, Sweep};
 use crate::compress::report::{entry_errors, rms_relative, standard_lights};
 use crate::compress::{
-    compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMetric,
-    ReorderOptions,
+    compress, gather, reorder, DenseEncoding, EncodeOptions, EncodedTransport, ReorderMethod,
+    ReorderMetric, ReorderOptions,
 };
 use crate::error::Result;
 use crate::pipeline::knobs::{EncodeKnobs, ReorderKnobs};
@@ -228,15 +228,20 @@ pub fn run(
         .unwrap_or_default();
 
     // 1. Reorder passes, with the radiosity thesis's encoding.
-    let mut runs: Vec<(u8, ReorderMetric)> = Vec::new();
+    // Every pass count with the thesis's full distance matrix (Linear and Log), then the
+    // bounded walk (Linear): the same permutations, at different cost.
+    let mut runs: Vec<(u8, ReorderMetric, ReorderMethod)> = Vec::new();
     let mut passes = cfg.passes.clone();
     passes.sort_unstable();
     passes.dedup();
     for &p in &passes {
-        runs.push((p, ReorderMetric::Linear));
+        runs.push((p, ReorderMetric::Linear, ReorderMethod::Full));
         if p > 0 {
-            runs.push((p, ReorderMetric::Log));
+            runs.push((p, ReorderMetric::Log, ReorderMethod::Full));
         }
+    }
+    for &p in passes.iter().filter(|&&p| p > 0) {
+        runs.push((p, ReorderMetric::Linear, ReorderMethod::Bounded));
     }
     let mut reorder_sweep = Sweep {
         name: "compression_reorder".into(),
@@ -255,26 +260,35 @@ pub fn run(
     };
     progress.begin("study: reorder", runs.len() as u64);
     let mut default_perm = None;
-    for (p, metric) in runs {
-        let (perm, secs) = timed(|| reorder(s, ReorderOptions { passes: p, metric }));
+    // The bounded reorder transposes the matrix in place and back: it works on a copy here.
+    let mut scratch = s.clone();
+    for (p, metric, method) in runs {
+        let opts = ReorderOptions {
+            passes: p,
+            metric,
+            method,
+        };
+        let (perm, secs) = timed(|| reorder(&mut scratch, opts));
         let sp = s.permuted(&perm);
         let (enc, enc_secs) = timed(|| compress(&sp, perm.clone(), 4.0, &seed_options()));
         let enc = enc?;
-        let label = if p == 0 {
-            "0 passes".to_string()
-        } else {
-            format!("{p} passes {metric:?}")
+        let bounded = method == ReorderMethod::Bounded;
+        let label = match (p, bounded) {
+            (0, _) => "0 passes".to_string(),
+            (_, false) => format!("{p} passes {metric:?}"),
+            (_, true) => format!("{p} passes {metric:?} bounded"),
         };
-        let series = if p == 0 {
-            "Linear".into()
-        } else {
-            format!("{metric:?}")
+        let series = match (p, bounded) {
+            (0, _) => "Linear".into(),
+            (_, false) => format!("{metric:?}"),
+            (_, true) => format!("{metric:?} bounded"),
         };
         let d = ReorderKnobs::default();
         let mut st = Setting::new(label, series)
-            .default_if(p == d.passes && (p == 0 || metric == d.metric))
+            .default_if(p == d.passes && metric == d.metric && method == d.method)
             .knob("passes", p)
             .knob("metric", format!("{metric:?}"))
+            .knob("method", format!("{method:?}"))
             .knob("encoding", DenseEncoding::Bc1Log.name())
             .knob("split_percent", 4.0)
             .knob("fill_holes", false);
@@ -283,7 +297,7 @@ pub fn run(
         st.extra.insert("encode_seconds".into(), enc_secs);
         reorder_sweep.settings.push(st);
         // The product default (2 Linear passes, or the most passes swept) feeds sweep 2.
-        if metric == ReorderMetric::Linear {
+        if metric == ReorderMetric::Linear && !bounded {
             default_perm = Some((p, perm, sp));
         }
         progress.advance(1);
@@ -310,10 +324,10 @@ pub fn run(
         Some(d) => d,
         None => {
             let perm = reorder(
-                s,
+                &mut scratch,
                 ReorderOptions {
                     passes: 2,
-                    metric: ReorderMetric::Linear,
+                    ..Default::default()
                 },
             );
             let sp = s.permuted(&perm);

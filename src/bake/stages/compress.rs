@@ -19,7 +19,7 @@ impl StageRun for ReorderKnobs {
         txn: &mut BakeTransaction,
         progress: &dyn Progress,
     ) -> Result<StageRecord> {
-        let s = ws.transport()?;
+        let s = ws.transport_mut()?;
         progress.begin("reorder", 0);
         let perm = reorder(s, self.options());
         progress.finish();

@@ -6,7 +6,7 @@ use clap::{Args, Subcommand};
 use relume::baked::export::StandardLight;
 use relume::compress::containers::Container;
 use relume::compress::dense::DenseEncoding;
-use relume::compress::reorder::ReorderMetric;
+use relume::compress::reorder::{ReorderMethod, ReorderMetric};
 use relume::error::exit;
 use relume::pipeline::checks::{self, arg};
 use relume::pipeline::knobs::{EncodeKnobs, ReorderKnobs};
@@ -26,6 +26,9 @@ pub enum CompressCommand {
         /// What the passes compare (default: linear)
         #[arg(long, value_enum)]
         metric: Option<ReorderMetric>,
+        /// How each step finds the nearest row (default: bounded; full is the thesis's O(n³))
+        #[arg(long, value_enum)]
+        method: Option<ReorderMethod>,
     },
     /// Split, map and block-compress a bake's transport (uses permutation.bin when present)
     Encode {
@@ -113,11 +116,13 @@ pub fn run(cmd: &CompressCommand, ui: &Ui, json: bool, quiet: bool) -> Result<i3
             baked_dir,
             passes,
             metric,
+            method,
         } => {
             let d = ReorderKnobs::default();
             let knobs = ReorderKnobs {
                 passes: passes.unwrap_or(d.passes),
                 metric: metric.unwrap_or(d.metric),
+                method: method.unwrap_or(d.method),
             };
             (baked_dir, Stage::Reorder(knobs))
         }

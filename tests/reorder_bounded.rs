@@ -1,0 +1,104 @@
+#![allow(clippy::needless_range_loop)]
+//! The bounded greedy reorder finds exactly the thesis's greedy order (the full all-pairs
+//! distance matrix), for any matrix, pass count and channel count, and leaves the matrix it
+//! transposes in place bit-for-bit as it was.
+
+#[path = "support/transport_box.rs"]
+mod transport_box;
+
+use proptest::prelude::*;
+use relume::compress::reorder_bounded::{permute_rows_in_place, transpose_in_place};
+use relume::compress::{reorder, ReorderMethod, ReorderMetric, ReorderOptions};
+use relume::radiosity::TransportMatrix;
+
+fn both(m: &TransportMatrix, passes: u8) -> (Vec<u32>, Vec<u32>) {
+    let full = reorder(
+        &mut m.clone(),
+        ReorderOptions {
+            passes,
+            metric: ReorderMetric::Linear,
+            method: ReorderMethod::Full,
+        },
+    );
+    let mut copy = m.clone();
+    let bounded = reorder(
+        &mut copy,
+        ReorderOptions {
+            passes,
+            metric: ReorderMetric::Linear,
+            method: ReorderMethod::Bounded,
+        },
+    );
+    assert_eq!(
+        copy.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        m.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        "the bounded reorder restores the matrix bit for bit"
+    );
+    (full, bounded)
+}
+
+#[test]
+fn bounded_equals_full_on_closed_box_transports() {
+    for k in [2usize, 3] {
+        let m = transport_box::transport(&transport_box::closed_box(k, 7), None);
+        for passes in [1u8, 2] {
+            let (full, bounded) = both(&m, passes);
+            assert_eq!(full, bounded, "box {k}, {passes} pass(es)");
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Random matrices, including coarsely quantised ones full of exact ties (the lowest index
+    /// must win in both) and matrices longer than one 512-coordinate chunk across channels.
+    #[test]
+    fn bounded_equals_full_on_random_matrices(
+        n in 3usize..90,
+        three in any::<bool>(),
+        levels in prop_oneof![Just(3u32), Just(1000u32)],
+        seed in any::<u64>(),
+        passes in 1u8..=2,
+    ) {
+        let ch = if three { 3 } else { 1 };
+        let mut x = seed | 1;
+        let data: Vec<f32> = (0..ch * n * n)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                (x % levels as u64) as f32 / levels as f32
+            })
+            .collect();
+        let m = TransportMatrix::new(ch, n, data).unwrap();
+        let (full, bounded) = both(&m, passes);
+        prop_assert_eq!(full, bounded);
+    }
+}
+
+#[test]
+fn in_place_moves_undo_exactly() {
+    let n = 37;
+    let data: Vec<f32> = (0..3 * n * n).map(|k| k as f32 * 0.5).collect();
+    let m = TransportMatrix::new(3, n, data).unwrap();
+    let mut t = m.clone();
+    transpose_in_place(&mut t);
+    assert_eq!(t.get(2, 3, 11), m.get(2, 11, 3));
+    transpose_in_place(&mut t);
+    assert_eq!(t, m);
+    let perm: Vec<u32> = (0..n as u32).map(|k| (k * 10 + 3) % n as u32).collect();
+    let mut p = m.clone();
+    permute_rows_in_place(&mut p, &perm, false);
+    for c in 0..3 {
+        for k in 0..n {
+            assert_eq!(
+                p.row(c, k),
+                m.row(c, perm[k] as usize),
+                "row {k} is old row perm[k]"
+            );
+        }
+    }
+    permute_rows_in_place(&mut p, &perm, true);
+    assert_eq!(p, m);
+}
