@@ -26,6 +26,7 @@ pub mod bc6h;
 pub mod containers;
 pub mod decode;
 pub mod dense;
+pub mod distance;
 pub mod encode;
 pub mod gather;
 pub mod logmap;

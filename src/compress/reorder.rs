@@ -13,6 +13,7 @@
 //! block encoder actually compresses) instead of the raw values, which are dominated by the few
 //! large entries that the split removes anyway.
 
+use super::distance::{l1, KCHUNK};
 use super::logmap::LogMap;
 use crate::radiosity::TransportMatrix;
 use rayon::prelude::*;
@@ -160,8 +161,6 @@ fn channel_max(v: &[f32]) -> f32 {
 }
 
 const TILE: usize = 64;
-/// Coordinates per chunk of a distance (cache blocking; part of the summation order).
-pub const KCHUNK: usize = 512;
 
 /// All pairwise L1 distances between the `n` vectors of length `d` in `x` (n×n, symmetric,
 /// zero diagonal). Blocked: tiles of 64×64 pairs over chunks of 512 coordinates, so both tiles'
@@ -208,35 +207,6 @@ pub fn pairwise_l1(x: &[f32], n: usize, d: usize) -> Vec<f32> {
     dist
 }
 
-/// The L1 distance of two whole vectors exactly as [`pairwise_l1`] sums it: chunks of
-/// `KCHUNK` coordinates, each by [`l1`], added in order.
-pub fn l1_chunked(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = 0.0f32;
-    for (ca, cb) in a.chunks(KCHUNK).zip(b.chunks(KCHUNK)) {
-        acc += l1(ca, cb);
-    }
-    acc
-}
-
-/// Sum of absolute differences with eight accumulators (vectorises).
-#[inline]
-pub fn l1(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = [0.0f32; 8];
-    let ca = a.chunks_exact(8);
-    let cb = b.chunks_exact(8);
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for l in 0..8 {
-            acc[l] += (x[l] - y[l]).abs();
-        }
-    }
-    let mut s = 0.0f32;
-    for (x, y) in ra.iter().zip(rb) {
-        s += (x - y).abs();
-    }
-    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + s
-}
-
 /// The radiosity thesis's walk: start at 0, repeatedly go to the nearest unvisited vector (ties: lowest
 /// index).
 fn greedy_walk(dist: &[f32], n: usize) -> Vec<u32> {
@@ -265,6 +235,38 @@ fn greedy_walk(dist: &[f32], n: usize) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compress::distance::l1_chunked;
+    use crate::compress::reorder_bounded::l1_concat;
+
+    /// The one summation order: `l1_concat` over channel rows, `l1_chunked` over their
+    /// concatenation and every entry of `pairwise_l1` agree bit for bit, also when a chunk spans
+    /// two channels (n = 300: chunks of 512 straddle the rows).
+    #[test]
+    fn every_distance_sums_in_the_same_order() {
+        for (n, ch) in [(300usize, 3usize), (1100, 1), (7, 3)] {
+            let vecs: Vec<Vec<f32>> = (0..4)
+                .map(|v| {
+                    (0..ch * n)
+                        .map(|k| (((k * 7919 + v * 104729) % 1013) as f32 / 1013.0).powi(3))
+                        .collect()
+                })
+                .collect();
+            let flat: Vec<f32> = vecs.concat();
+            let all = pairwise_l1(&flat, 4, ch * n);
+            for a in 0..4 {
+                for b in 0..4 {
+                    let (ra, rb): (Vec<&[f32]>, Vec<&[f32]>) =
+                        (vecs[a].chunks(n).collect(), vecs[b].chunks(n).collect());
+                    let c = l1_concat(&ra, &rb, f32::INFINITY);
+                    let want = l1_chunked(&vecs[a], &vecs[b]);
+                    assert_eq!(c.to_bits(), want.to_bits(), "n {n} ch {ch}");
+                    if a != b {
+                        assert_eq!(all[a * 4 + b].to_bits(), want.to_bits(), "n {n} ch {ch}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn pairwise_matches_brute_force() {

@@ -9,7 +9,7 @@
 //! bound does not exceed the best exact distance, nearest bound first: each is re-bounded with
 //! the `FINE` signature and measured exactly only if that bound does not exclude it either. No
 //! vector it skips can be nearer. The exact distances are
-//! computed exactly as [`super::reorder::pairwise_l1`] computes them (chunks of 512
+//! computed exactly as `super::reorder::pairwise_l1` computes them (chunks of 512
 //! coordinates, eight accumulators), and ties go to the lowest index, so the permutation is the
 //! thesis's greedy one, bit for bit (tested).
 //!
@@ -22,7 +22,7 @@
 //! Precondition: the features are the raw (non-negative or not) f32 values of S (`Linear`); the
 //! `Log` metric uses [`super::reorder`]'s feature vectors.
 
-use super::reorder::{l1, KCHUNK};
+use super::distance::{l1, KCHUNK};
 use crate::radiosity::TransportMatrix;
 use rayon::prelude::*;
 
@@ -68,7 +68,7 @@ impl Vectors<'_> {
 /// building them: chunks of `KCHUNK` that span two rows are copied to a small buffer. Stops
 /// early with a value above `limit` once the running sum exceeds it (every chunk adds ≥ 0, so
 /// the full sum would too); otherwise the value is exactly `l1_chunked`'s.
-fn l1_concat(a: &[&[f32]], b: &[&[f32]], limit: f32) -> f32 {
+pub(crate) fn l1_concat(a: &[&[f32]], b: &[&[f32]], limit: f32) -> f32 {
     let n = a[0].len();
     let d = n * a.len();
     let mut acc = 0.0f32;
