@@ -215,7 +215,9 @@ fn compression_quick_sweeps_reorder_split_and_encodings() {
             "2 passes Linear",
             "2 passes Log",
             "1 passes Linear bounded",
-            "2 passes Linear bounded"
+            "1 passes Linear budgeted",
+            "2 passes Linear bounded",
+            "2 passes Linear budgeted"
         ]
     );
     // The bounded walk finds the thesis's greedy order: the same errors as the full one.

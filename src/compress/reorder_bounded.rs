@@ -100,7 +100,10 @@ fn l1_f64(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The greedy walk (start at 0, always the nearest remaining vector, ties to the lowest index).
-pub fn bounded_walk(v: &Vectors) -> Vec<u32> {
+/// With `budget = Some(k)` a step measures at most `k` exact distances (the candidates with
+/// the smallest bounds) and takes the nearest of those: an approximation of the walk whose cost
+/// no longer depends on how many rows are near-ties.
+pub fn bounded_walk(v: &Vectors, budget: Option<usize>) -> Vec<u32> {
     let (n, ch) = (v.m.n, v.m.channels);
     if n <= 2 {
         return (0..n as u32).collect();
@@ -154,8 +157,9 @@ pub fn bounded_walk(v: &Vectors) -> Vec<u32> {
             .filter(|&k| k != first && lbs[k] <= best_d as f64)
             .collect();
         todo.sort_by(|&a, &b| lbs[a].total_cmp(&lbs[b]).then(a.cmp(&b)));
+        let mut measured = 1;
         for k in todo {
-            if lbs[k] > best_d as f64 {
+            if lbs[k] > best_d as f64 || budget.is_some_and(|b| measured >= b) {
                 break;
             }
             let r = remaining[k] as usize;
@@ -163,6 +167,7 @@ pub fn bounded_walk(v: &Vectors) -> Vec<u32> {
             if lb > best_d as f64 {
                 continue;
             }
+            measured += 1;
             let dist = exact(r, best_d);
             if dist < best_d || (dist == best_d && r < remaining[best] as usize) {
                 best = k;

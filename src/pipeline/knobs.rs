@@ -116,8 +116,9 @@ pub struct ReorderKnobs {
     /// sees; measured no better, see docs/compression.md).
     #[serde(default = "default_metric")]
     pub metric: ReorderMetric,
-    /// `Bounded` (default: the thesis's greedy order found with lower bounds, near O(n²)) or
-    /// `Full` (the thesis's all-pairs distance matrix, O(n³)): the same permutation.
+    /// `Budgeted` (default: the greedy walk with lower bounds and at most 8 exact distances per
+    /// step), `Bounded` (the thesis's exact greedy order, found with lower bounds) or `Full`
+    /// (the thesis's all-pairs distance matrix, O(n³); the same order as `Bounded`).
     #[serde(default)]
     pub method: ReorderMethod,
 }

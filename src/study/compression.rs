@@ -242,6 +242,7 @@ pub fn run(
     }
     for &p in passes.iter().filter(|&&p| p > 0) {
         runs.push((p, ReorderMetric::Linear, ReorderMethod::Bounded));
+        runs.push((p, ReorderMetric::Linear, ReorderMethod::Budgeted));
     }
     let mut reorder_sweep = Sweep {
         name: "compression_reorder".into(),
@@ -272,16 +273,21 @@ pub fn run(
         let sp = s.permuted(&perm);
         let (enc, enc_secs) = timed(|| compress(&sp, perm.clone(), 4.0, &seed_options()));
         let enc = enc?;
-        let bounded = method == ReorderMethod::Bounded;
-        let label = match (p, bounded) {
-            (0, _) => "0 passes".to_string(),
-            (_, false) => format!("{p} passes {metric:?}"),
-            (_, true) => format!("{p} passes {metric:?} bounded"),
+        let full = method == ReorderMethod::Full;
+        let suffix = match method {
+            ReorderMethod::Full => "",
+            ReorderMethod::Bounded => " bounded",
+            ReorderMethod::Budgeted => " budgeted",
         };
-        let series = match (p, bounded) {
-            (0, _) => "Linear".into(),
-            (_, false) => format!("{metric:?}"),
-            (_, true) => format!("{metric:?} bounded"),
+        let label = if p == 0 {
+            "0 passes".to_string()
+        } else {
+            format!("{p} passes {metric:?}{suffix}")
+        };
+        let series = if p == 0 {
+            "Linear".into()
+        } else {
+            format!("{metric:?}{suffix}")
         };
         let d = ReorderKnobs::default();
         let mut st = Setting::new(label, series)
@@ -297,7 +303,7 @@ pub fn run(
         st.extra.insert("encode_seconds".into(), enc_secs);
         reorder_sweep.settings.push(st);
         // The product default (2 Linear passes, or the most passes swept) feeds sweep 2.
-        if metric == ReorderMetric::Linear && !bounded {
+        if metric == ReorderMetric::Linear && full {
             default_perm = Some((p, perm, sp));
         }
         progress.advance(1);

@@ -26,7 +26,7 @@ pub enum CompressCommand {
         /// What the passes compare (default: linear)
         #[arg(long, value_enum)]
         metric: Option<ReorderMetric>,
-        /// How each step finds the nearest row (default: bounded; full is the thesis's O(n³))
+        /// How each step finds the next row (default: budgeted; bounded: the thesis's exact order, fast; full: the thesis's O(n³))
         #[arg(long, value_enum)]
         method: Option<ReorderMethod>,
     },
