@@ -144,3 +144,28 @@ fn budgeted_walk_is_a_permutation_and_compresses_nearly_as_well() {
     eprintln!("summed error: exact walk {exact}, budgeted {budgeted}");
     assert!(budgeted <= exact * 1.04, "{budgeted} vs {exact}");
 }
+
+/// The walks compute their bounds in parallel: the permutation is the same for 1 and 2 threads.
+#[test]
+fn the_permutation_does_not_depend_on_the_thread_count() {
+    let m = transport_box::transport(&transport_box::closed_box(6, 11), None);
+    for method in [ReorderMethod::Bounded, ReorderMethod::Budgeted] {
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    reorder(
+                        &mut m.clone(),
+                        ReorderOptions {
+                            passes: 2,
+                            metric: ReorderMetric::Linear,
+                            method,
+                        },
+                    )
+                })
+        };
+        assert_eq!(run(1), run(2), "{method:?}");
+    }
+}
