@@ -1,7 +1,8 @@
 //! All-or-nothing writing of a baked directory: every file goes into a temporary sibling
 //! directory; only when the manifest is written does the temporary directory replace the target
-//! (rename, with the previous bake kept until the swap succeeded). A failed or interrupted bake
-//! leaves the previous bake untouched and no partial output.
+//! (one atomic exchange of the two directories on Linux, else two renames with the previous bake
+//! kept until the swap succeeded). A failed or killed bake leaves the previous bake untouched;
+//! the next bake into the same output removes what a killed one left (`clean_stale`).
 
 use super::manifest::{hash_file, FileRecord, Manifest, MANIFEST};
 use crate::error::{Error, IoContext, Result};
@@ -31,11 +32,14 @@ impl BakeTransaction {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| "bake".into());
+        clean_stale(&parent, &name, target)?;
         let tmp = parent.join(format!(".{name}.relume-tmp-{}", std::process::id()));
         if tmp.exists() {
             std::fs::remove_dir_all(&tmp).at(&tmp, "cannot remove stale temporary directory")?;
         }
         std::fs::create_dir(&tmp).at(&tmp, "cannot create temporary directory")?;
+        let lock = tmp.join(LOCK);
+        std::fs::write(&lock, owner_tag(std::process::id())).at(&lock, "cannot write")?;
         Ok(BakeTransaction {
             target: target.to_path_buf(),
             tmp,
@@ -109,6 +113,8 @@ impl BakeTransaction {
         manifest.files = self.files();
         let mpath = self.tmp.join(MANIFEST);
         std::fs::write(&mpath, manifest.to_ron()).at(&mpath, "cannot write")?;
+        let lock = self.tmp.join(LOCK);
+        std::fs::remove_file(&lock).at(&lock, "cannot remove")?;
         check_target(&self.target)?;
         if self.target.exists() {
             let old = self.tmp.with_file_name(
@@ -118,15 +124,21 @@ impl BakeTransaction {
                     .to_string_lossy()
                     .replace("relume-tmp", "relume-old"),
             );
-            std::fs::rename(&self.target, &old)
-                .at(&self.target, "cannot move the previous bake aside")?;
-            if let Err(e) = std::fs::rename(&self.tmp, &self.target) {
-                let _ = std::fs::rename(&old, &self.target);
-                return Err(Error::io(
-                    &self.target,
-                    "cannot move the new bake into place",
-                    e,
-                ));
+            if exchange(&self.tmp, &self.target) {
+                // One atomic step: the target is the new bake, `tmp` holds the previous one.
+                std::fs::rename(&self.tmp, &old)
+                    .at(&self.tmp, "cannot move the previous bake aside")?;
+            } else {
+                std::fs::rename(&self.target, &old)
+                    .at(&self.target, "cannot move the previous bake aside")?;
+                if let Err(e) = std::fs::rename(&self.tmp, &self.target) {
+                    let _ = std::fs::rename(&old, &self.target);
+                    return Err(Error::io(
+                        &self.target,
+                        "cannot move the new bake into place",
+                        e,
+                    ));
+                }
             }
             let _ = std::fs::remove_dir_all(&old);
         } else {
@@ -143,6 +155,107 @@ impl Drop for BakeTransaction {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.tmp);
         }
+    }
+}
+
+/// The lock file in a temporary bake directory: `PID START` of the process writing it (START:
+/// the process's start time in clock ticks since boot, from `/proc/PID/stat`, so that a reused
+/// PID is not taken for the writer).
+pub const LOCK: &str = ".relume-lock";
+
+/// `PID START` of a process (START empty where `/proc` is not there).
+fn owner_tag(pid: u32) -> String {
+    format!("{pid} {}", start_time(pid).unwrap_or_default())
+}
+
+/// Field 22 of `/proc/PID/stat` (after the parenthesised command name).
+fn start_time(pid: u32) -> Option<String> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let after = &stat[stat.rfind(')')? + 1..];
+    after.split_whitespace().nth(19).map(str::to_string)
+}
+
+/// Is the process that wrote `tag` (`PID START`) still running?
+fn owner_alive(tag: &str) -> bool {
+    let mut w = tag.split_whitespace();
+    let Some(pid) = w.next().and_then(|p| p.parse::<u32>().ok()) else {
+        return false;
+    };
+    match (start_time(pid), w.next()) {
+        (Some(now), Some(then)) => now == then,
+        (Some(_), None) => true,
+        // No /proc entry: the process is gone (or this is not Linux: ask the kernel).
+        (None, _) if Path::new("/proc/self").exists() => false,
+        // SAFETY: signal 0 only checks that the process exists.
+        (None, _) => (unsafe { libc::kill(pid as libc::pid_t, 0) }) == 0,
+    }
+}
+
+/// Remove what killed bakes of `target` left beside it: `.NAME.relume-tmp-PID` directories of
+/// processes that no longer run (never a live one's), and `.NAME.relume-old-PID` ones, which hold
+/// the previous bake if a process died between the two renames of a commit: moved back when the
+/// target is missing, else removed.
+fn clean_stale(parent: &Path, name: &str, target: &Path) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return Ok(());
+    };
+    let (tmp_prefix, old_prefix) = (
+        format!(".{name}.relume-tmp-"),
+        format!(".{name}.relume-old-"),
+    );
+    for e in entries.flatten() {
+        let file = e.file_name().to_string_lossy().into_owned();
+        let (is_old, pid) = if let Some(p) = file.strip_prefix(&tmp_prefix) {
+            (false, p)
+        } else if let Some(p) = file.strip_prefix(&old_prefix) {
+            (true, p)
+        } else {
+            continue;
+        };
+        let Ok(pid) = pid.parse::<u32>() else {
+            continue;
+        };
+        let path = e.path();
+        let tag = std::fs::read_to_string(path.join(LOCK)).unwrap_or_else(|_| format!("{pid}"));
+        if pid == std::process::id() || owner_alive(&tag) {
+            continue;
+        }
+        if is_old && !target.exists() {
+            std::fs::rename(&path, target).at(target, "cannot restore the previous bake")?;
+        } else {
+            std::fs::remove_dir_all(&path).at(&path, "cannot remove a killed bake's leftovers")?;
+        }
+    }
+    Ok(())
+}
+
+/// Swap two directories atomically (Linux `renameat2(RENAME_EXCHANGE)`); false where the system
+/// or the file system cannot, and the caller falls back to two renames.
+fn exchange(a: &Path, b: &Path) -> bool {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let (Ok(ca), Ok(cb)) = (
+            std::ffi::CString::new(a.as_os_str().as_bytes()),
+            std::ffi::CString::new(b.as_os_str().as_bytes()),
+        ) else {
+            return false;
+        };
+        // SAFETY: two valid NUL-terminated paths relative to the working directory.
+        unsafe {
+            libc::renameat2(
+                libc::AT_FDCWD,
+                ca.as_ptr(),
+                libc::AT_FDCWD,
+                cb.as_ptr(),
+                libc::RENAME_EXCHANGE,
+            ) == 0
+        }
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    {
+        let _ = (a, b);
+        false
     }
 }
 
