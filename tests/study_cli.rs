@@ -309,10 +309,13 @@ fn terrain_quick_accelerated_equals_exact_and_report_is_thread_independent() {
         );
     }
 
-    // Everything but the times is the same with two threads.
-    let dir2 = tempfile::tempdir().unwrap();
-    let j2 = study(dir2.path(), &["terrain", "-j", "2"]);
-    assert_eq!(strip_times(j), strip_times(j2));
+    // Everything but the times is the same with two and with eight threads.
+    let base = strip_times(j);
+    for threads in ["2", "8"] {
+        let dir2 = tempfile::tempdir().unwrap();
+        let j2 = study(dir2.path(), &["terrain", "-j", threads]);
+        assert_eq!(base, strip_times(j2), "-j {threads}");
+    }
 }
 
 /// The report without measured times (and numbers derived from them) and the thread count.
