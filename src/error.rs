@@ -110,8 +110,19 @@ impl Error {
         }
     }
 
-    /// An I/O error naming `path` and what was being done (`"cannot read"`, ...).
+    /// An I/O error naming `path` and what was being done (`"cannot read"`, ...). A file that
+    /// ends too soon or is not the text it should be is the input's fault, not the file
+    /// system's: those become [`Error::Input`] ("truncated" / "malformed").
     pub fn io(path: impl AsRef<Path>, action: &'static str, source: std::io::Error) -> Self {
+        use std::io::ErrorKind;
+        let fault = match source.kind() {
+            ErrorKind::UnexpectedEof => Some("truncated: the file ends early"),
+            ErrorKind::InvalidData => Some("malformed"),
+            _ => None,
+        };
+        if let Some(fault) = fault {
+            return Error::input(path, format!("{action}: {fault} ({source})"));
+        }
         Error::Io {
             path: path.as_ref().to_path_buf(),
             action,

@@ -53,6 +53,9 @@ fn read_image(path: &Path) -> Result<RawGrid> {
             ))
         }
     };
+    if format == "jpeg" {
+        check_jpeg_complete(path)?;
+    }
     let img = reader.decode().map_err(|e| match e {
         image::ImageError::IoError(io) => Error::io(path, "cannot read height map", io),
         other => Error::input(path, format!("cannot decode {format}: {other}")),
@@ -85,6 +88,27 @@ fn read_image(path: &Path) -> Result<RawGrid> {
         nodata: None,
         cell_size: None,
     })
+}
+
+/// The JPEG decoder fills a truncated scan with made-up samples instead of failing (found by the
+/// bad-input corpus: a cut file read as a "colour image"), so a JPEG must have its end-of-image
+/// marker after its last start-of-scan. Markers cannot occur inside entropy-coded data (a 0xFF
+/// there is stuffed as FF 00), so the search is exact.
+fn check_jpeg_complete(path: &Path) -> Result<()> {
+    let bytes = std::fs::read(path).at(path, "cannot read height map")?;
+    let last_scan = bytes.windows(2).rposition(|w| w == [0xFF, 0xDA]);
+    let complete = last_scan.is_some_and(|s| bytes[s..].windows(2).any(|w| w == [0xFF, 0xD9]));
+    if complete {
+        Ok(())
+    } else {
+        Err(Error::input(
+            path,
+            format!(
+                "truncated JPEG: no end-of-image marker after the last scan ({} bytes)",
+                bytes.len()
+            ),
+        ))
+    }
 }
 
 /// Take one channel of an RGB image whose channels are all equal; refuse real colour images.

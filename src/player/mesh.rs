@@ -145,6 +145,27 @@ fn load_radiosity(
         return Ok(None);
     }
     let set = baked::patches::read(dir)?;
+    if set.corners.len() != renderer.corners() as usize {
+        return Err(super::mixed_bakes(
+            dir,
+            baked::patches::FILE,
+            format!("covers {} mesh corners", set.corners.len()),
+            format!("{} has {}", baked::scene::FILE, renderer.corners()),
+        ));
+    }
+    let patches = set.patches.len();
+    let same_patches = |file: &str, n: usize| {
+        if n == patches {
+            Ok(())
+        } else {
+            Err(super::mixed_bakes(
+                dir,
+                file,
+                format!("holds a transport of {n} patches"),
+                format!("{} has {patches}", baked::patches::FILE),
+            ))
+        }
+    };
     let use_dense = match opts.transport {
         TransportChoice::Dense => true,
         TransportChoice::Compressed => false,
@@ -158,6 +179,7 @@ fn load_radiosity(
             ));
         }
         let matrix = baked::transport::read(dir)?;
+        same_patches(baked::transport::FILE, matrix.n)?;
         RadiosityRuntime::new(gpu, &set, TransportSource::Dense(&matrix), renderer)?
     } else {
         if !has_encoded {
@@ -167,6 +189,7 @@ fn load_radiosity(
             ));
         }
         let encoded = baked::encoded::read(dir)?;
+        same_patches(baked::encoded::SIDECAR_FILE, encoded.dense.n)?;
         let path = opts
             .decode
             .unwrap_or_else(|| DecodePath::best(gpu, encoded.dense.encoding));

@@ -154,3 +154,11 @@ impl Player {
         }
     }
 }
+
+/// Files of one bake that disagree: most likely copied together from different bakes.
+fn mixed_bakes(dir: &Path, file: &str, has: String, other: String) -> crate::error::Error {
+    crate::error::Error::input(
+        dir.join(file),
+        format!("{has}, but {other}: the files come from different bakes (bake again)"),
+    )
+}

@@ -37,6 +37,17 @@ impl TerrainPlayer {
         } else {
             MinMaxMipmap::build(&map)
         };
+        if (mip.map_width, mip.map_height) != (map.width, map.height) {
+            return Err(super::mixed_bakes(
+                dir,
+                baked::mipmap::FILE,
+                format!(
+                    "is the mipmap of a {}x{} map",
+                    mip.map_width, mip.map_height
+                ),
+                format!("{} is {}x{}", baked::heightmap::FILE, map.width, map.height),
+            ));
+        }
         let renderer = TerrainRenderer::new(gpu, &map, &mip, width, height, None)?;
         Ok(TerrainPlayer {
             map,

@@ -12,13 +12,7 @@ use gltf::mesh::Mode;
 use std::path::Path;
 
 pub(super) fn load(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
-    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, "cannot read scene", e))?;
-    if meta.is_dir() {
-        return Err(Error::input(
-            path,
-            "is a directory, expected a .gltf or .glb file",
-        ));
-    }
+    check_accessor_indices(path)?;
     let (doc, buffers, images) = gltf::import(path).map_err(|e| describe(path, e))?;
 
     let mut scene = Scene::default();
@@ -172,6 +166,41 @@ pub(super) fn load(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
 }
 
 /// Turn a `gltf` error into one naming the file and sorted by cause.
+/// gltf-json 1.4's validation indexes the accessor a primitive's `POSITION` names before checking
+/// that it exists, so a malformed file panics inside `gltf::import` (found by the bad-input
+/// corpus). Check every accessor index a primitive names first; anything else malformed is left
+/// to `gltf::import`'s own errors.
+fn check_accessor_indices(path: &Path) -> Result<()> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, "cannot read scene", e))?;
+    let Ok(gltf) = gltf::Gltf::from_slice_without_validation(&bytes) else {
+        return Ok(());
+    };
+    let accessors = gltf.document.as_json().accessors.len();
+    for (m, mesh) in gltf.document.as_json().meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let named = prim.attributes.values().chain(prim.indices.iter()).chain(
+                prim.targets.iter().flatten().flat_map(|t| {
+                    [&t.positions, &t.normals, &t.tangents]
+                        .into_iter()
+                        .flatten()
+                }),
+            );
+            for a in named {
+                if a.value() >= accessors {
+                    return Err(Error::input(
+                        path,
+                        format!(
+                            "mesh {m} primitive {p} names accessor {}, but the file has {accessors}",
+                            a.value()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn describe(path: &Path, e: gltf::Error) -> Error {
     match e {
         gltf::Error::Io(io) => Error::input(

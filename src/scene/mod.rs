@@ -121,6 +121,12 @@ pub fn load_scene(path: &Path, opts: SceneOptions) -> Result<(Scene, LoadWarning
             opts.scale
         )));
     }
+    if path.is_dir() {
+        return Err(Error::input(
+            path,
+            "is a directory, expected a scene file (.obj, .gltf or .glb)",
+        ));
+    }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -151,6 +157,12 @@ pub fn load_scene(path: &Path, opts: SceneOptions) -> Result<(Scene, LoadWarning
     }
     scene.validate(path)?;
     let degenerate = scene.degenerate_triangles().count();
+    if degenerate == scene.triangles.len() {
+        return Err(Error::input(
+            path,
+            format!("all {degenerate} triangle(s) are degenerate (zero area): nothing to light"),
+        ));
+    }
     if degenerate > 0 {
         warnings.push(format!(
             "{degenerate} degenerate (zero-area) triangle(s) will be ignored by the bake"

@@ -7,10 +7,7 @@ use std::path::Path;
 
 pub(super) fn load(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
     // tobj reports a missing file as a parse failure; check readability first for a clear I/O error.
-    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, "cannot read scene", e))?;
-    if meta.is_dir() {
-        return Err(Error::input(path, "is a directory, expected an .obj file"));
-    }
+    std::fs::metadata(path).map_err(|e| Error::io(path, "cannot read scene", e))?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

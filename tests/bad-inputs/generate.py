@@ -24,3 +24,18 @@ open("colour.png", "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack
                                + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 # A raw f32 file of 3 values (not a whole 2x2 grid).
 open("short.raw", "wb").write(struct.pack("<3f", 1, 2, 3))
+# Added with the discovered corpus (tests/bad_inputs.rs):
+# A .npy of the wrong shape and one of float64, for tampered bakes given to the player.
+np.save("wrong-shape.npy", np.zeros((3, 5), dtype=np.float32))
+np.save("float64.npy", np.zeros((3, 4, 4), dtype=np.float64))
+# A raw f32 2x2 grid with a NaN.
+open("nan.raw", "wb").write(struct.pack("<4f", 1, float("nan"), 3, 4))
+# The first 2000 bytes of the bundled Puget Sound JPEG, and 5000 of the Big Tujunga GeoTIFF.
+open("truncated.jpg", "wb").write(open("../../scenes/dem/puget_sound_4k.jpg", "rb").read()[:2000])
+open("truncated.tif", "wb").write(open("../../scenes/dem/srtm_bigtujunga_30m.tif", "rb").read()[:5000])
+# An EXR header of version 1 (relume reads OpenEXR 2.0).
+open("not-an-exr.exr", "wb").write(b"v/1\x01" + b"\x00" * 60)
+# 200 random bytes named .ron.
+import random
+random.seed(7)
+open("binary.ron", "wb").write(bytes(random.randrange(256) for _ in range(200)))
