@@ -196,3 +196,35 @@ impl<T> IoContext<T> for std::io::Result<T> {
         self.map_err(|e| Error::io(path, action, e))
     }
 }
+
+/// Run a third-party decoder that may panic on malformed input (a bug of that crate), turning a
+/// panic into [`Error::Input`] naming `path`. The panic message is kept out of stderr: a user
+/// sees one clear error, not a backtrace. Other threads' panics still reach the previous hook.
+pub fn contain_panic<T>(path: &Path, decoder: &str, f: impl FnOnce() -> T) -> Result<T> {
+    use std::cell::Cell;
+    use std::panic::{catch_unwind, AssertUnwindSafe};
+    thread_local!(static CONTAINED: Cell<bool> = const { Cell::new(false) });
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !CONTAINED.with(Cell::get) {
+                previous(info)
+            }
+        }));
+    });
+    CONTAINED.with(|c| c.set(true));
+    let r = catch_unwind(AssertUnwindSafe(f));
+    CONTAINED.with(|c| c.set(false));
+    r.map_err(|payload| {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Error::input(
+            path,
+            format!("malformed file: the {decoder} failed ({what})"),
+        )
+    })
+}

@@ -2,6 +2,59 @@
 
 use crate::error::{Error, Result};
 
+/// The most samples (texels x channels) relume decodes from one image file: 2^30, e.g. a
+/// 32768² height map, 4 GiB as f32. Decoders allocate what a header declares before they read
+/// the data, so a damaged header is refused against this before any decoding.
+pub const MAX_IMAGE_SAMPLES: u64 = 1 << 30;
+
+/// Refuse an image whose header declares more than [`MAX_IMAGE_SAMPLES`].
+pub fn check_declared_samples(
+    path: &std::path::Path,
+    width: u64,
+    height: u64,
+    channels: u64,
+) -> Result<()> {
+    let samples = width.saturating_mul(height).saturating_mul(channels);
+    if samples > MAX_IMAGE_SAMPLES {
+        return Err(Error::input(
+            path,
+            format!(
+                "the header declares {width}x{height} texels x {channels} channel(s), over relume's \
+                 limit of 2^30 samples per image (a damaged header, or split the map into tiles)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Read an OpenEXR file's headers and refuse one whose parts together declare more than
+/// [`MAX_IMAGE_SAMPLES`], before the `exr` crate allocates them.
+pub fn check_exr_header(path: &std::path::Path) -> Result<()> {
+    let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) else {
+        return Ok(()); // the decoder reports the malformed header itself
+    };
+    let (mut samples, mut last) = (0u64, (0, 0, 0));
+    for h in meta.headers.iter() {
+        let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
+        last = (w, ht, h.channels.list.len() as u64);
+        samples = samples.saturating_add(w.saturating_mul(ht).saturating_mul(last.2));
+    }
+    if samples > MAX_IMAGE_SAMPLES {
+        return Err(Error::input(
+            path,
+            format!(
+                "the header declares {samples} samples in {} part(s) (the last {}x{} x {} \
+                 channel(s)), over relume's limit of 2^30 per image: a damaged header?",
+                meta.headers.len(),
+                last.0,
+                last.1,
+                last.2
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Physical memory of this machine in bytes (Linux `/proc/meminfo`; 8 GiB when unknown).
 pub fn physical_memory() -> u64 {
     std::fs::read_to_string("/proc/meminfo")

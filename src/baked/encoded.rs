@@ -96,9 +96,61 @@ pub fn read(dir: &Path) -> Result<EncodedTransport> {
         info.channels as usize,
         info.padded as usize,
     );
+    let info_path = dir.join(TRANSFER_FILE);
+    // Sizes come from the file: check them before allocating the texture. `perm` has n entries,
+    // which bounds n by the file's length; the texture by the tiles' lengths below.
+    if !(1..=4).contains(&ch)
+        || info.maps.len() != ch
+        || info.perm.len() != n
+        || padded != 4 * n.div_ceil(4)
+    {
+        return Err(Error::input(
+            &info_path,
+            format!(
+                "inconsistent sizes: n {n}, padded {padded}, {ch} channel(s) with {} map(s), \
+                 a permutation of {}",
+                info.maps.len(),
+                info.perm.len()
+            ),
+        ));
+    }
     let nl = DenseTexture::layer_count(info.encoding, ch);
     let enc = info.encoding;
     let layer_len = (padded / 4) * (padded / 4) * enc.block_bytes();
+    let container = *info
+        .containers
+        .first()
+        .ok_or_else(|| Error::input(&info_path, "lists no container"))?;
+    let tile_path = |stem: &str| dir.join(format!("{stem}.{}", container.extension()));
+    // Every tile file must hold the blocks transfer.bin says it has, and the tiles must cover
+    // the texture: so what is allocated below is bounded by the bytes on disk.
+    let mut covered = 0u64;
+    for t in &info.tiles {
+        let path = tile_path(&t.stem);
+        let need = (t.cols.div_ceil(4) as u64)
+            * (t.rows.div_ceil(4) as u64)
+            * (enc.block_bytes() * nl) as u64;
+        let have = std::fs::metadata(&path).at(&path, "cannot read")?.len();
+        if have < need {
+            return Err(Error::input(
+                &path,
+                format!(
+                    "{have} bytes: too short for the {}x{} {} tile transfer.bin describes \
+                     (truncated, or from another bake)",
+                    t.cols,
+                    t.rows,
+                    enc.name()
+                ),
+            ));
+        }
+        covered += t.cols as u64 * t.rows as u64;
+    }
+    if covered != (padded as u64) * (padded as u64) {
+        return Err(Error::input(
+            &info_path,
+            format!("its tiles cover {covered} texels of a {padded}x{padded} texture"),
+        ));
+    }
     let mut tex = DenseTexture {
         encoding: enc,
         n,
@@ -107,12 +159,8 @@ pub fn read(dir: &Path) -> Result<EncodedTransport> {
         maps: info.maps.clone(),
         layers: vec![vec![0u8; layer_len]; nl],
     };
-    let container = *info
-        .containers
-        .first()
-        .ok_or_else(|| Error::input(dir.join(TRANSFER_FILE), "lists no container"))?;
     for tile in &info.tiles {
-        let path = dir.join(format!("{}.{}", tile.stem, container.extension()));
+        let path = tile_path(&tile.stem);
         let (w, h, layers) = match container {
             Container::Dds => {
                 containers::parse_dds(&path, &std::fs::read(&path).at(&path, "cannot read")?, enc)?
@@ -138,11 +186,7 @@ pub fn read(dir: &Path) -> Result<EncodedTransport> {
     }
     tex.validate()?;
     let sidecar = read_sidecar(&dir.join(SIDECAR_FILE))?;
-    if sidecar.n != n
-        || sidecar.channels != ch
-        || !is_permutation(&info.perm)
-        || info.perm.len() != n
-    {
+    if sidecar.n != n || sidecar.channels != ch || !is_permutation(&info.perm) {
         return Err(Error::input(
             dir.join(SIDECAR_FILE),
             "sidecar or permutation does not match transfer.bin",

@@ -67,6 +67,7 @@ pub fn write_file(path: &Path, mip: &MinMaxMipmap) -> Result<()> {
 pub fn read_file(path: &Path) -> Result<MinMaxMipmap> {
     use exr::meta::attribute::AttributeValue;
     use exr::prelude::*;
+    crate::limits::check_exr_header(path)?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

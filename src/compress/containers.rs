@@ -206,12 +206,43 @@ pub fn dds_bytes(
     Ok(out)
 }
 
+/// The largest DDS side relume reads: twice the largest tile it writes (`max_texture_size`).
+const MAX_DDS_SIDE: u32 = 16384;
+
+/// `ddsfile` computes sizes from the header with unchecked arithmetic (overflows found by
+/// fuzzing), so the header's sizes are checked here first: one 2-D level, sides in
+/// 1..=[`MAX_DDS_SIDE`], at most 64 array layers. relume writes exactly such files.
+fn check_dds_header(path: &Path, bytes: &[u8]) -> Result<()> {
+    let bad = |m: String| Error::input(path, format!("not a DDS file relume writes: {m}"));
+    if bytes.len() < 128 || &bytes[..4] != b"DDS " {
+        return Err(bad("missing `DDS ` header".into()));
+    }
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    let (height, width, depth, mips) = (u32_at(12), u32_at(16), u32_at(24), u32_at(28));
+    if !(1..=MAX_DDS_SIDE).contains(&width) || !(1..=MAX_DDS_SIDE).contains(&height) {
+        return Err(bad(format!(
+            "{width}x{height} texels (sides must be 1..={MAX_DDS_SIDE})"
+        )));
+    }
+    if depth > 1 || mips > 1 {
+        return Err(bad(format!(
+            "depth {depth}, {mips} mip levels (expected 1 and 1)"
+        )));
+    }
+    let dx10 = &bytes[84..88] == b"DX10";
+    if dx10 && bytes.len() >= 148 && u32_at(140) > 64 {
+        return Err(bad(format!("{} array layers (at most 64)", u32_at(140))));
+    }
+    Ok(())
+}
+
 /// Parse a DDS tile: (width, height, layers). `path` names the file in errors.
 pub fn parse_dds(
     path: &Path,
     bytes: &[u8],
     enc: DenseEncoding,
 ) -> Result<(u32, u32, Vec<Vec<u8>>)> {
+    check_dds_header(path, bytes)?;
     let dds = Dds::read(bytes).map_err(|e| Error::input(path, format!("not a DDS file: {e}")))?;
     let ok = match enc {
         DenseEncoding::Bc1Log => {

@@ -100,10 +100,15 @@ impl Sidecar {
         let n = u32_at(8) as usize;
         let channels = u32_at(12) as usize;
         let nnz = u64::from_le_bytes(bytes[16..24].try_into().unwrap()) as usize;
-        let expect = HEADER + 4 * (n + 1) + 4 * nnz + 4 * nnz * channels;
-        if bytes.len() != expect {
+        // Checked: the counts come from the file, and a wrapped sum could match its length.
+        let expect = (n as u64 + 1)
+            .checked_add(nnz as u64)
+            .and_then(|w| w.checked_add((nnz as u64).checked_mul(channels as u64)?))
+            .and_then(|w| w.checked_mul(4)?.checked_add(HEADER as u64));
+        if expect != Some(bytes.len() as u64) {
+            let implied = expect.map_or("more than 2^64".into(), |e| e.to_string());
             return Err(bad(&format!(
-                "{} bytes, header implies {expect}",
+                "{} bytes, header implies {implied}",
                 bytes.len()
             )));
         }

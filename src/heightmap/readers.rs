@@ -56,6 +56,14 @@ fn read_image(path: &Path) -> Result<RawGrid> {
     if format == "jpeg" {
         check_jpeg_complete(path)?;
     }
+    // The header alone, before the decoder allocates (and walks) what it declares.
+    if let Ok((w, h)) = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(image::ImageError::IoError)
+        .and_then(|r| r.into_dimensions())
+    {
+        crate::limits::check_declared_samples(path, w as u64, h as u64, 1)?;
+    }
     let img = reader.decode().map_err(|e| match e {
         image::ImageError::IoError(io) => Error::io(path, "cannot read height map", io),
         other => Error::input(path, format!("cannot decode {format}: {other}")),
@@ -138,6 +146,7 @@ fn equal_channels<T: Copy + PartialEq + Into<f64>>(
 
 fn read_exr(path: &Path) -> Result<RawGrid> {
     use exr::prelude::{read, FlatSamples, ReadChannels, ReadLayers};
+    crate::limits::check_exr_header(path)?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -195,8 +204,15 @@ fn read_tiff(path: &Path) -> Result<RawGrid> {
         }
         other => Error::input(path, format!("cannot decode TIFF: {other}")),
     };
-    let mut dec = Decoder::new(std::io::BufReader::new(file)).map_err(tiff_err)?;
+    // tiff 0.10 panics on some malformed tags (an empty SampleFormat, found by fuzzing).
+    let mut dec = crate::error::contain_panic(path, "TIFF decoder", || {
+        let mut limits = tiff::decoder::Limits::default();
+        limits.decoding_buffer_size = (crate::limits::MAX_IMAGE_SAMPLES * 8) as usize;
+        Decoder::new(std::io::BufReader::new(file)).map(|d| d.with_limits(limits))
+    })?
+    .map_err(tiff_err)?;
     let (w, h) = dec.dimensions().map_err(tiff_err)?;
+    crate::limits::check_declared_samples(path, w as u64, h as u64, 1)?;
     match dec.colortype().map_err(tiff_err)? {
         ColorType::Gray(_) => {}
         other => {

@@ -19,7 +19,7 @@ pub mod parse;
 mod stage;
 
 pub use parse::{parse_pipeline, PLANNED_STAGES};
-pub use stage::{Stage, StageKind};
+pub use stage::{check_order, Stage, StageKind};
 
 use crate::heightmap::{HeightMapOptions, NoDataPolicy};
 use crate::scene::SceneOptions;

@@ -87,7 +87,7 @@ impl StageKind {
 }
 
 /// Check that every stage fits the input kind and comes after the stages it needs.
-pub(super) fn check_order(path: &Path, pipeline: &Pipeline) -> Result<()> {
+pub fn check_order(path: &Path, pipeline: &Pipeline) -> Result<()> {
     let mut done: Vec<StageKind> = Vec::new();
     for stage in &pipeline.stages {
         let kind = stage.kind();

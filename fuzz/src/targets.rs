@@ -1,0 +1,158 @@
+//! One harness per fuzz target. Each takes arbitrary bytes, hands them to relume's readers the
+//! way a user's file would reach them, and ignores the result: any `Err` is a correct answer; a
+//! panic, an abort (e.g. an allocation the input made up), or a hang is a bug.
+//!
+//! The first byte of the input selects the reader within a target, so that one coverage-guided
+//! run explores all of them. Inputs that need a file are written to a per-process scratch
+//! directory (`/dev/shm` when it exists), because the readers take paths, like the CLI.
+//!
+//! This file depends only on `relume` and `std`: `tests/fuzz_corpus.rs` includes it to replay
+//! every corpus and crash input as a regression test.
+
+use std::path::{Path, PathBuf};
+
+/// The fuzz targets, by name (the `src/bin/` files and `fuzz/corpus/<name>/`).
+pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+    ("scene", scene),
+    ("heightmap", heightmap),
+    ("text", text),
+    ("baked", baked),
+];
+
+fn scratch() -> PathBuf {
+    let base = if Path::new("/dev/shm").is_dir() {
+        PathBuf::from("/dev/shm")
+    } else {
+        std::env::temp_dir()
+    };
+    let dir = base.join(format!("relume-fuzz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    dir
+}
+
+/// Write `bytes` to a fresh scratch file named `name` (in a directory of its own).
+fn file(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = scratch().join("f");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).expect("scratch file");
+    path
+}
+
+fn split(data: &[u8]) -> Option<(u8, &[u8])> {
+    data.split_first().map(|(s, rest)| (*s, rest))
+}
+
+/// OBJ, glTF (JSON) and GLB scenes through `load_scene`.
+pub fn scene(data: &[u8]) {
+    let Some((sel, rest)) = split(data) else {
+        return;
+    };
+    let name = ["scene.obj", "scene.gltf", "scene.glb"][sel as usize % 3];
+    let path = file(name, rest);
+    let _ = relume::scene::load_scene(&path, relume::scene::SceneOptions::default());
+}
+
+/// Every height-map reader (PNG, JPEG, EXR, GeoTIFF, raw f32) through `load_heightmap`, with a
+/// no-data policy from the selector byte.
+pub fn heightmap(data: &[u8]) {
+    use relume::heightmap::{HeightMapOptions, NoDataPolicy};
+    let Some((sel, rest)) = split(data) else {
+        return;
+    };
+    let name = ["h.png", "h.jpg", "h.exr", "h.tif", "h.raw"][sel as usize % 5];
+    let mut opts = HeightMapOptions {
+        nodata: [
+            NoDataPolicy::Error,
+            NoDataPolicy::FillMin,
+            NoDataPolicy::FillNearest,
+        ][(sel as usize / 5) % 3],
+        downsample: [1, 2, 3][(sel as usize / 15) % 3],
+        ..Default::default()
+    };
+    let mut body = rest;
+    if name == "h.raw" {
+        if rest.len() < 2 {
+            return;
+        }
+        opts.raw_size = Some([rest[0] as usize + 1, rest[1] as usize + 1]);
+        body = &rest[2..];
+    }
+    let path = file(name, body);
+    let _ = relume::heightmap::load_heightmap(&path, &opts);
+}
+
+/// Pipeline RON (parsed and checked, as `run` does before any work) and bake manifests.
+pub fn text(data: &[u8]) {
+    let Some((sel, rest)) = split(data) else {
+        return;
+    };
+    let Ok(text) = std::str::from_utf8(rest) else {
+        return;
+    };
+    let path = Path::new("fuzz.ron");
+    if sel % 2 == 0 {
+        if let Ok(p) = relume::pipeline::parse::parse_str(path, text) {
+            let _ = relume::pipeline::check_order(path, &p);
+        }
+    } else {
+        let _ = relume::baked::Manifest::from_ron(path, text);
+    }
+}
+
+/// The player's readers of a baked directory: patches, scene, transfer info, sidecar, the
+/// `.npy` matrices, the permutation, the mipmap EXR, and the DDS / KTX2 texture parsers for
+/// every encoding.
+pub fn baked(data: &[u8]) {
+    use relume::baked;
+    use relume::compress::{containers, DenseEncoding};
+    let Some((sel, rest)) = split(data) else {
+        return;
+    };
+    let encodings = [
+        DenseEncoding::Bc6h,
+        DenseEncoding::Bc1Log,
+        DenseEncoding::Bc4Log,
+        DenseEncoding::F16,
+        DenseEncoding::F32,
+    ];
+    let enc = encodings[(sel as usize / 10) % encodings.len()];
+    match sel % 10 {
+        0 => drop(baked::patches::read_file(&file(baked::patches::FILE, rest))),
+        1 => {
+            let p = file(baked::scene::FILE, rest);
+            drop(baked::scene::read(p.parent().unwrap()));
+        }
+        2 => drop(baked::encoded::read(
+            file(baked::encoded::TRANSFER_FILE, rest).parent().unwrap(),
+        )),
+        3 => drop(baked::encoded::read_sidecar(&file(
+            baked::encoded::SIDECAR_FILE,
+            rest,
+        ))),
+        4 => drop(baked::transport::read_file(&file(
+            baked::transport::FILE,
+            rest,
+        ))),
+        5 => drop(baked::form_factors::read_file(&file(
+            baked::form_factors::FILE,
+            rest,
+        ))),
+        6 => drop(baked::permutation::read_file(&file(
+            baked::permutation::FILE,
+            rest,
+        ))),
+        7 => drop(baked::mipmap::read_file(&file(baked::mipmap::FILE, rest))),
+        8 => drop(containers::parse_dds(Path::new("t.dds"), rest, enc)),
+        _ => {
+            let layers = 1 + (sel as usize / 50) % 3;
+            drop(containers::parse_ktx2(
+                Path::new("t.ktx2"),
+                rest,
+                enc,
+                layers,
+            ))
+        }
+    }
+}
