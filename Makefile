@@ -6,12 +6,12 @@ BAKE     := target/release/relume-bake
 PLAYER   := target/release/relume-player
 SUDO     := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth
-PY_PKGS  := pillow numpy openexr tifffile
+PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder
 export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
 
-.PHONY: all build demo docs-images test deps deps-apt deps-py fmt lint bench study ci clean
+.PHONY: all build demo docs-images test deps deps-apt deps-py fuzz fmt lint bench study ci clean
 
 all: build
 
@@ -105,10 +105,20 @@ deps-apt:
 	fi
 
 deps-py:
-	@python3 -c "import PIL, numpy, OpenEXR, tifffile" 2>/dev/null || { \
+	@python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder" 2>/dev/null || { \
 	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) && \
-	  python3 -c "import PIL, numpy, OpenEXR, tifffile"; } || \
+	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder"; } || \
 	  { echo "error: cannot install the Python cross-check readers ($(PY_PKGS))" >&2; exit 1; }
+
+## Coverage-guided fuzzing of every reader with AFL++ on stable Rust (docs/fuzzing.md): EXECS
+## executions per target (default 10 M; hours on 2 cores), crashes in $(FUZZ_OUT)/<target>/.
+FUZZ_OUT     ?= out/fuzz
+FUZZ_TARGETS ?= scene heightmap text baked
+fuzz:
+	@command -v cargo-afl >/dev/null 2>&1 || $(CARGO) install cargo-afl --locked
+	@test -d $$HOME/.local/share/afl.rs || $(CARGO) afl config --build
+	cd fuzz && $(CARGO) afl build --release
+	fuzz/run.sh $(abspath $(FUZZ_OUT)) $(FUZZ_TARGETS)
 
 fmt:
 	$(CARGO) fmt --all

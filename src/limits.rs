@@ -28,10 +28,11 @@ pub fn check_declared_samples(
 }
 
 /// Read an OpenEXR file's headers and refuse one whose parts together declare more than
-/// [`MAX_IMAGE_SAMPLES`], before the `exr` crate allocates them.
-pub fn check_exr_header(path: &std::path::Path) -> Result<()> {
+/// [`MAX_IMAGE_SAMPLES`], before the `exr` crate allocates them. Returns the number of parts
+/// (0 when the header is unreadable: the decoder then reports it).
+pub fn check_exr_header(path: &std::path::Path) -> Result<usize> {
     let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) else {
-        return Ok(()); // the decoder reports the malformed header itself
+        return Ok(0);
     };
     let (mut samples, mut last) = (0u64, (0, 0, 0));
     for h in meta.headers.iter() {
@@ -52,7 +53,7 @@ pub fn check_exr_header(path: &std::path::Path) -> Result<()> {
             ),
         ));
     }
-    Ok(())
+    Ok(meta.headers.len())
 }
 
 /// Physical memory of this machine in bytes (Linux `/proc/meminfo`; 8 GiB when unknown).

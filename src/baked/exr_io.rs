@@ -51,7 +51,13 @@ pub fn write_f32_channels(
 /// Read the first layer's channels as f32: (width, height, [(name, values)]), channels sorted by name.
 pub fn read_f32_channels(path: &Path) -> Result<(usize, usize, Channels)> {
     use exr::prelude::{read, FlatSamples, ReadChannels, ReadLayers};
-    crate::limits::check_exr_header(path)?;
+    let parts = crate::limits::check_exr_header(path)?;
+    if parts > 1 {
+        return Err(Error::input(
+            path,
+            format!("a multi-part EXR ({parts} parts) where relume writes a single part"),
+        ));
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()

@@ -25,13 +25,142 @@ pub fn write_npy_f32(path: &Path, shape: &[u64], data: &[f32]) -> Result<()> {
 }
 
 /// Read an f32 `.npy` file: (shape, values).
+///
+/// Hand-written rather than `npyz`'s reader: `npyz` parses the header with a general Python
+/// literal grammar (`py_literal`, a backtracking PEG) that takes over 30 s on some 130-byte
+/// damaged headers (found by fuzzing; `fuzz/regressions/baked/npy-*`). relume reads only what it
+/// writes, `{'descr': '<f4', 'fortran_order': False, 'shape': (...), }` (format versions 1-3), so
+/// this parser accepts exactly that, in time linear in the header. `npyz` still writes the files,
+/// and numpy reads them in the tests: the two sides stay independent.
 pub fn read_npy_f32(path: &Path) -> Result<(Vec<u64>, Vec<f32>)> {
     let bytes = std::fs::read(path).at(path, "cannot read")?;
-    let npy = npyz::NpyFile::new(&bytes[..])
-        .map_err(|e| Error::input(path, format!("not a .npy file: {e}")))?;
-    let shape = npy.shape().to_vec();
-    let data = npy
-        .into_vec::<f32>()
-        .map_err(|e| Error::input(path, format!("not an f32 .npy file: {e}")))?;
+    let (shape, data) = parse_npy_f32(&bytes).map_err(|m| Error::input(path, m))?;
     Ok((shape, data))
+}
+
+/// Parse the bytes of an f32 `.npy` file (see [`read_npy_f32`]); the error is a message.
+pub fn parse_npy_f32(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<f32>), String> {
+    let bad = |m: &str| format!("not a .npy file: {m}");
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return Err(bad("missing the \\x93NUMPY magic"));
+    }
+    let (len, start) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10usize),
+        2 | 3 if bytes.len() >= 12 => (
+            u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize,
+            12,
+        ),
+        v => return Err(bad(&format!("format version {v}"))),
+    };
+    let header = bytes
+        .get(start..start.saturating_add(len))
+        .ok_or_else(|| bad("the header runs past the end of the file"))?;
+    let header = std::str::from_utf8(header).map_err(|_| bad("the header is not text"))?;
+    let compact: String = header.chars().filter(|c| !c.is_whitespace()).collect();
+    let body = compact
+        .strip_prefix('{')
+        .and_then(|b| b.strip_suffix('}'))
+        .ok_or_else(|| bad("the header is not a dictionary"))?;
+    let (mut descr, mut fortran, mut shape) = (None, None, None);
+    let mut rest = body;
+    while !rest.is_empty() {
+        let (key, after) = rest
+            .split_once(':')
+            .ok_or_else(|| bad("a header entry without a value"))?;
+        let (value, next) = if let Some(tuple) = after.strip_prefix('(') {
+            let end = tuple.find(')').ok_or_else(|| bad("an unclosed shape"))?;
+            (&after[..end + 2], &tuple[end + 1..])
+        } else {
+            after.split_at(after.find(',').unwrap_or(after.len()))
+        };
+        match key {
+            "'descr'" => descr = Some(value),
+            "'fortran_order'" => fortran = Some(value),
+            "'shape'" => shape = Some(value),
+            k => return Err(bad(&format!("unexpected header key {k}"))),
+        }
+        rest = next.strip_prefix(',').unwrap_or(next);
+    }
+    match descr {
+        Some("'<f4'") => {}
+        Some(d) => return Err(format!("not an f32 .npy file: dtype {d}")),
+        None => return Err(bad("no 'descr' in the header")),
+    }
+    if fortran != Some("False") {
+        return Err(bad("Fortran order (relume writes C order)"));
+    }
+    let dims = shape
+        .and_then(|s| s.strip_prefix('('))
+        .and_then(|s| s.strip_suffix(')'))
+        .ok_or_else(|| bad("no 'shape' tuple in the header"))?;
+    let shape: Vec<u64> = dims
+        .split(',')
+        .filter(|d| !d.is_empty())
+        .map(|d| d.parse::<u64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| bad(&format!("shape ({dims}) is not a tuple of sizes")))?;
+    let data = &bytes[start + len..];
+    let count = shape.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
+    if count.and_then(|c| c.checked_mul(4)) != Some(data.len() as u64) {
+        return Err(bad(&format!(
+            "shape {shape:?} needs {} bytes of data, the file has {}",
+            count.map_or("more than 2^64".into(), |c| (c * 4).to_string()),
+            data.len()
+        )));
+    }
+    let values = data
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    Ok((shape, values))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What numpy 1.x/2.x writes for `np.save(f, np.zeros(shape, "<f4"))` (header padded to 64).
+    fn numpy_file(shape: &str, descr: &str, data: &[f32]) -> Vec<u8> {
+        let mut h = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+        while (10 + h.len() + 1) % 64 != 0 {
+            h.push(' ');
+        }
+        h.push('\n');
+        let mut out = b"\x93NUMPY\x01\x00".to_vec();
+        out.extend_from_slice(&(h.len() as u16).to_le_bytes());
+        out.extend_from_slice(h.as_bytes());
+        out.extend(data.iter().flat_map(|v| v.to_le_bytes()));
+        out
+    }
+
+    #[test]
+    fn reads_what_numpy_and_npyz_write() {
+        let (shape, v) =
+            parse_npy_f32(&numpy_file("(2, 3)", "<f4", &[1., 2., 3., 4., 5., 6.])).unwrap();
+        assert_eq!((shape, v), (vec![2, 3], vec![1., 2., 3., 4., 5., 6.]));
+        let (shape, v) = parse_npy_f32(&numpy_file("(1,)", "<f4", &[7.])).unwrap();
+        assert_eq!((shape, v), (vec![1], vec![7.]));
+        let (shape, v) = parse_npy_f32(&numpy_file("()", "<f4", &[9.])).unwrap();
+        assert_eq!((shape, v), (vec![], vec![9.]));
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("m.npy");
+        let data: Vec<f32> = (0..24).map(|i| i as f32 * 0.5).collect();
+        write_npy_f32(&p, &[2, 3, 4], &data).unwrap();
+        assert_eq!(read_npy_f32(&p).unwrap(), (vec![2, 3, 4], data));
+    }
+
+    #[test]
+    fn refuses_what_it_does_not_write() {
+        let err = |b: &[u8]| parse_npy_f32(b).unwrap_err();
+        assert!(err(&numpy_file("(2,)", "<f8", &[0., 0., 0., 0.])).contains("not an f32"));
+        let good = numpy_file("(2, 3)", "<f4", &[0.; 6]);
+        assert!(err(&good[..good.len() - 4]).contains("needs 24 bytes"));
+        assert!(err(&good[..40]).contains("runs past the end"));
+        assert!(err(&numpy_file("(99999999999, 99999999999, 99)", "<f4", &[])).contains("needs"));
+        assert!(err(b"PK\x03\x04 not numpy").contains("magic"));
+        let mut f = good.clone();
+        let at = f.windows(5).position(|w| w == b"False").unwrap();
+        f[at..at + 5].copy_from_slice(b"True ");
+        assert!(err(&f).contains("Fortran"));
+    }
 }

@@ -112,6 +112,18 @@ pub fn load_heightmap(path: &Path, opts: &HeightMapOptions) -> Result<(HeightMap
             ),
         ));
     }
+    if raw.values.len() != raw.width * raw.height {
+        // Found by fuzzing: the TIFF decoder can return fewer samples than the header declares.
+        return Err(Error::input(
+            path,
+            format!(
+                "decoded {} samples for a {}x{} map: the file's data is incomplete",
+                raw.values.len(),
+                raw.width,
+                raw.height
+            ),
+        ));
+    }
     let (cell_size, cell_size_source) = match (opts.cell_size, raw.cell_size) {
         (Some(c), _) => (c, "option"),
         (None, Some((c, source))) => (c, source),

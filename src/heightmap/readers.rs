@@ -63,6 +63,16 @@ fn read_image(path: &Path) -> Result<RawGrid> {
         .and_then(|r| r.into_dimensions())
     {
         crate::limits::check_declared_samples(path, w as u64, h as u64, 1)?;
+        if format == "jpeg" && w.max(h) > 65528 {
+            // zune-jpeg 0.5 computes `(side + 7) / 8` in u16: it wraps and decodes zeros (an
+            // overflow panic under the fuzzers' overflow checks).
+            return Err(Error::unsupported(
+                path,
+                format!(
+                    "a {w}x{h} JPEG: sides over 65528 texels are mis-decoded by the JPEG decoder"
+                ),
+            ));
+        }
     }
     let img = reader.decode().map_err(|e| match e {
         image::ImageError::IoError(io) => Error::io(path, "cannot read height map", io),
@@ -146,7 +156,15 @@ fn equal_channels<T: Copy + PartialEq + Into<f64>>(
 
 fn read_exr(path: &Path) -> Result<RawGrid> {
     use exr::prelude::{read, FlatSamples, ReadChannels, ReadLayers};
-    crate::limits::check_exr_header(path)?;
+    let parts = crate::limits::check_exr_header(path)?;
+    if parts > 1 {
+        // A multi-part file (e.g. a bake's minmax_mipmap.exr) is not one height field; reading
+        // its first part also trips an internal assertion of exr 1.74 (found by fuzzing).
+        return Err(Error::unsupported(
+            path,
+            format!("a multi-part EXR ({parts} parts): a height map is a single-part file"),
+        ));
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
