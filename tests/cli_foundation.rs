@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{bake, data, expect_code, list_files, text};
+use common::{bake, data, expect_code, list_files};
 use relume::error::exit;
 use std::path::Path;
 

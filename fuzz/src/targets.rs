@@ -11,8 +11,11 @@
 
 use std::path::{Path, PathBuf};
 
+/// A harness: arbitrary bytes in, nothing out.
+pub type Harness = fn(&[u8]);
+
 /// The fuzz targets, by name (the `src/bin/` files and `fuzz/corpus/<name>/`).
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Harness)] = &[
     ("scene", scene),
     ("heightmap", heightmap),
     ("text", text),
