@@ -11,7 +11,14 @@ use glam::{Mat4, Vec3, Vec4};
 use gltf::mesh::Mode;
 use std::path::Path;
 
+/// Load a glTF scene. The `gltf` crate 1.4 panics on many malformed files (unreachable code,
+/// `unwrap`s and assertions in its readers, found by fuzzing: `fuzz/regressions/scene/`), so the
+/// whole load runs under [`crate::error::contain_panic`]: a clear input error, never a crash.
 pub(super) fn load(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
+    crate::error::contain_panic(path, "glTF reader", || load_unguarded(path, warnings))?
+}
+
+fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
     check_accessor_indices(path)?;
     let (doc, buffers, images) = gltf::import(path).map_err(|e| describe(path, e))?;
 
