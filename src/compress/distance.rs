@@ -15,21 +15,9 @@ pub fn l1_chunked(a: &[f32], b: &[f32]) -> f32 {
     acc
 }
 
-/// Sum of absolute differences with eight accumulators (vectorises).
+/// Sum of absolute differences with eight accumulators (vectorises; the summation order of
+/// `radiosity::matrix::sum_pairs8`).
 #[inline]
 pub fn l1(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = [0.0f32; 8];
-    let ca = a.chunks_exact(8);
-    let cb = b.chunks_exact(8);
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for l in 0..8 {
-            acc[l] += (x[l] - y[l]).abs();
-        }
-    }
-    let mut s = 0.0f32;
-    for (x, y) in ra.iter().zip(rb) {
-        s += (x - y).abs();
-    }
-    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + s
+    crate::radiosity::matrix::sum_pairs8(a, b, |x, y| (x - y).abs())
 }

@@ -31,10 +31,17 @@ pub(super) fn read(path: &Path, opts: &HeightMapOptions) -> Result<RawGrid> {
 
 fn read_image(path: &Path) -> Result<RawGrid> {
     use image::DynamicImage as D;
-    let reader = image::ImageReader::open(path).at(path, "cannot read height map")?;
-    let reader = reader
-        .with_guessed_format()
-        .at(path, "cannot read height map")?;
+    // Read once; the format guess, the checks and the decoder all work on these bytes.
+    let bytes = std::fs::read(path).at(path, "cannot read height map")?;
+    let open = || {
+        // As `ImageReader::open` does: the extension first, the signature when it has one.
+        let mut r = image::ImageReader::new(std::io::Cursor::new(&bytes[..]));
+        if let Ok(f) = image::ImageFormat::from_path(path) {
+            r.set_format(f);
+        }
+        r.with_guessed_format().at(path, "cannot read height map")
+    };
+    let reader = open()?;
     let format = match reader.format() {
         Some(image::ImageFormat::Png) => "png",
         Some(image::ImageFormat::Jpeg) => "jpeg",
@@ -54,14 +61,10 @@ fn read_image(path: &Path) -> Result<RawGrid> {
         }
     };
     if format == "jpeg" {
-        check_jpeg_complete(path)?;
+        check_jpeg_complete(path, &bytes)?;
     }
     // The header alone, before the decoder allocates (and walks) what it declares.
-    if let Ok((w, h)) = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(image::ImageError::IoError)
-        .and_then(|r| r.into_dimensions())
-    {
+    if let Ok((w, h)) = open()?.into_dimensions() {
         crate::limits::check_declared_samples(path, w as u64, h as u64, 1)?;
         if format == "jpeg" && w.max(h) > 65528 {
             // zune-jpeg 0.5 computes `(side + 7) / 8` in u16: it wraps and decodes zeros (an
@@ -112,8 +115,7 @@ fn read_image(path: &Path) -> Result<RawGrid> {
 /// bad-input corpus: a cut file read as a "colour image"), so a JPEG must have its end-of-image
 /// marker after its last start-of-scan. Markers cannot occur inside entropy-coded data (a 0xFF
 /// there is stuffed as FF 00), so the search is exact.
-fn check_jpeg_complete(path: &Path) -> Result<()> {
-    let bytes = std::fs::read(path).at(path, "cannot read height map")?;
+fn check_jpeg_complete(path: &Path, bytes: &[u8]) -> Result<()> {
     let last_scan = bytes.windows(2).rposition(|w| w == [0xFF, 0xDA]);
     let complete = last_scan.is_some_and(|s| bytes[s..].windows(2).any(|w| w == [0xFF, 0xD9]));
     if complete {

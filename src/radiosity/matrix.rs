@@ -118,24 +118,31 @@ impl TransportMatrix {
     }
 }
 
-/// Dot product with eight independent f32 accumulators (vectorises; fixed order, so the
-/// result does not depend on threads).
-#[inline]
-pub fn dot(a: &[f32], b: &[f32]) -> f32 {
+/// Σ term(a_i, b_i) with eight independent f32 accumulators (vectorises; a fixed order, so the
+/// result does not depend on threads). The one summation kernel of [`dot`] and
+/// `compress::distance::l1`.
+#[inline(always)]
+pub fn sum_pairs8(a: &[f32], b: &[f32], term: impl Fn(f32, f32) -> f32) -> f32 {
     let mut acc = [0.0f32; 8];
     let ca = a.chunks_exact(8);
     let cb = b.chunks_exact(8);
     let (ra, rb) = (ca.remainder(), cb.remainder());
     for (x, y) in ca.zip(cb) {
         for l in 0..8 {
-            acc[l] += x[l] * y[l];
+            acc[l] += term(x[l], y[l]);
         }
     }
     let mut s = 0.0f32;
     for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
+        s += term(*x, *y);
     }
     ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + s
+}
+
+/// Dot product (see [`sum_pairs8`]).
+#[inline]
+pub fn dot(a: &[f32], b: &[f32]) -> f32 {
+    sum_pairs8(a, b, |x, y| x * y)
 }
 
 /// Apply a permutation to a light vector: `E'[c][k] = E[c][perm[k]]`.
