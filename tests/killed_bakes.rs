@@ -39,7 +39,13 @@ fn twenty_kills_spread_over_every_stage_leave_the_previous_bake_and_no_leftovers
     let out = tmp.path().join("out");
     let (ps, os) = (p.to_str().unwrap(), out.to_str().unwrap());
     let t0 = Instant::now();
-    expect_code(&bake(tmp.path(), &["-q", "run", ps, "--out", os]), 0);
+    expect_code(
+        &bake(
+            tmp.path(),
+            &["-q", "run", ps, "--force", "--no-cache", "--out", os],
+        ),
+        0,
+    );
     let full = t0.elapsed().as_secs_f64();
     let before = std::fs::read(out.join("manifest.ron")).unwrap();
     // Kill moments spread evenly over the whole bake (loading to the last rename), in a fixed
@@ -49,7 +55,7 @@ fn twenty_kills_spread_over_every_stage_leave_the_previous_bake_and_no_leftovers
     for k in 0..kills {
         let at = full * (k as f64 + 0.5) / kills as f64;
         let mut child = Command::new(env!("CARGO_BIN_EXE_relume-bake"))
-            .args(["-q", "run", ps, "--out", os])
+            .args(["-q", "run", ps, "--force", "--no-cache", "--out", os])
             .current_dir(tmp.path())
             .spawn()
             .unwrap();
@@ -64,7 +70,13 @@ fn twenty_kills_spread_over_every_stage_leave_the_previous_bake_and_no_leftovers
         left_behind > 0,
         "no kill landed while a bake was being written ({full:.2} s per bake)"
     );
-    expect_code(&bake(tmp.path(), &["-q", "run", ps, "--out", os]), 0);
+    expect_code(
+        &bake(
+            tmp.path(),
+            &["-q", "run", ps, "--force", "--no-cache", "--out", os],
+        ),
+        0,
+    );
     assert_eq!(leftovers(tmp.path()), Vec::<String>::new());
     expect_code(&bake(tmp.path(), &["inspect", os]), 0);
     // The final bake is the same bake as the first (deterministic), manifest and all.

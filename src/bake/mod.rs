@@ -1,6 +1,7 @@
 //! Running a pipeline: load the input, check the plan against the memory budget, run each stage
 //! in order into a [`BakeTransaction`], write the manifest and swap the bake into place.
 
+pub mod cache;
 pub mod estimate;
 pub mod plan;
 pub mod stages;
@@ -15,6 +16,7 @@ use crate::limits;
 use crate::load::{load_input, LoadedInput};
 use crate::pipeline::{Pipeline, Stage};
 use crate::progress::Progress;
+use cache::StageCache;
 use serde::Serialize;
 use stages::runner;
 use std::path::{Path, PathBuf};
@@ -26,12 +28,20 @@ use workspace::Workspace;
 pub struct BakeOptions {
     /// Refuse to start when the estimated peak memory exceeds this many bytes.
     pub max_memory: u64,
+    /// Root of the stage cache (`cache`): `None` runs every stage. The CLI's default is
+    /// `.relume-cache` beside the output.
+    pub cache: Option<PathBuf>,
+    /// Run every stage even when the output is up to date or the cache holds them (the cache is
+    /// refreshed with what runs).
+    pub force: bool,
 }
 
 impl Default for BakeOptions {
     fn default() -> Self {
         BakeOptions {
             max_memory: limits::default_max_memory(),
+            cache: None,
+            force: false,
         }
     }
 }
@@ -40,6 +50,9 @@ impl Default for BakeOptions {
 #[derive(Clone, Debug, Serialize)]
 pub struct BakeReport {
     pub output: PathBuf,
+    /// The output already held this bake (same pipeline, input, version; every file verified):
+    /// nothing was run or written.
+    pub up_to_date: bool,
     pub stages: Vec<StageTiming>,
     pub files: Vec<FileRecord>,
     pub warnings: Vec<String>,
@@ -50,6 +63,8 @@ pub struct BakeReport {
 pub struct StageTiming {
     pub stage: String,
     pub seconds: f64,
+    /// Taken from the stage cache instead of run.
+    pub cached: bool,
     pub outputs: Vec<String>,
     pub report: std::collections::BTreeMap<String, f64>,
 }
@@ -73,30 +88,64 @@ pub fn run_pipeline(
             warnings.push(m.clone());
         }
     }
-    let the_plan = plan(pipeline, &input, output);
-    limits::check_memory("this bake", the_plan.peak_bytes, opts.max_memory)?;
-
     let mut txn = BakeTransaction::begin(output)?;
     let mut records = Vec::new();
     let mut timings = Vec::new();
     let load_record = write_input(&mut txn, &input)?;
-    timings.push(timing(&load_record, t0));
+    let (bytes, sha256) = hash_file(pipeline.input.path())?;
+    if !opts.force && up_to_date(output, pipeline, &sha256, &txn.files()) {
+        return Ok(BakeReport {
+            output: output.to_path_buf(),
+            up_to_date: true,
+            stages: Vec::new(),
+            files: Manifest::read(output)?.files,
+            warnings,
+        });
+    }
+    let the_plan = plan(pipeline, &input, output);
+    limits::check_memory("this bake", the_plan.peak_bytes, opts.max_memory)?;
+    timings.push(timing(&load_record, t0, false));
     records.push(load_record);
 
     let mut ws = Workspace::new();
     ws.set_memory_budget(opts.max_memory);
+    ws.read_missing_from(txn.staging_dir());
     match input {
         LoadedInput::Scene(scene, _) => ws.set_scene(scene),
         LoadedInput::HeightMap(map, _) => ws.set_heightmap(map),
     }
+    let cache = opts
+        .cache
+        .as_deref()
+        .map(|root| StageCache::open(root, output));
+    let mut keys = Vec::new();
     for stage in &pipeline.stages {
         let t = Instant::now();
-        let rec = runner(stage).run(&mut ws, &mut txn, progress)?;
-        timings.push(timing(&rec, t));
+        let before = txn.files();
+        let key = StageCache::key(stage, &before);
+        let hit = cache
+            .as_ref()
+            .filter(|_| !opts.force)
+            .and_then(|c| c.lookup(&key));
+        let (rec, cached) = match hit {
+            Some(hit) => (hit.apply(&mut txn)?, true),
+            None => {
+                let rec = runner(stage).run(&mut ws, &mut txn, progress)?;
+                if let Some(c) = &cache {
+                    if let Err(e) = c.store(&key, stage, &rec, &before, &txn) {
+                        let w = format!("the stage cache is not kept: {e}");
+                        progress.warn(&w);
+                        warnings.push(w);
+                    }
+                }
+                (rec, false)
+            }
+        };
+        keys.push(key);
+        timings.push(timing(&rec, t, cached));
         records.push(rec);
     }
 
-    let (bytes, sha256) = hash_file(pipeline.input.path())?;
     let input_name = pipeline
         .input
         .path()
@@ -117,18 +166,41 @@ pub fn run_pipeline(
     };
     let files = txn.files();
     txn.commit(manifest)?;
+    if let Some(c) = &cache {
+        c.retain(&keys);
+    }
     Ok(BakeReport {
         output: output.to_path_buf(),
+        up_to_date: false,
         stages: timings,
         files,
         warnings,
     })
 }
 
-fn timing(record: &StageRecord, since: Instant) -> StageTiming {
+/// Does `output` already hold the bake of `pipeline` by this relume, from an input with this
+/// hash whose canonical form (`load_files`) is unchanged, with every file intact?
+fn up_to_date(
+    output: &Path,
+    pipeline: &Pipeline,
+    input_sha256: &str,
+    load_files: &[FileRecord],
+) -> bool {
+    let Ok(m) = Manifest::read(output) else {
+        return false;
+    };
+    m.relume_version == env!("CARGO_PKG_VERSION")
+        && m.pipeline == *pipeline
+        && m.input.sha256 == input_sha256
+        && load_files.iter().all(|f| m.file(&f.name) == Some(f))
+        && baked::manifest::verify(output, &m).is_empty()
+}
+
+fn timing(record: &StageRecord, since: Instant, cached: bool) -> StageTiming {
     StageTiming {
         stage: record.stage.clone(),
         seconds: since.elapsed().as_secs_f64(),
+        cached,
         outputs: record.outputs.clone(),
         report: record.report.clone(),
     }
@@ -247,7 +319,7 @@ pub fn run_stage_on_with(
     ws.set_memory_budget(opts.max_memory);
     let t = Instant::now();
     let rec = runner(&stage).run(&mut ws, &mut txn, progress)?;
-    let timings = vec![timing(&rec, t)];
+    let timings = vec![timing(&rec, t, false)];
     records.push(rec);
     pipeline.stages.push(stage);
     let files = txn.files();
@@ -260,6 +332,7 @@ pub fn run_stage_on_with(
     txn.commit(new_manifest)?;
     Ok(BakeReport {
         output: dir.to_path_buf(),
+        up_to_date: false,
         stages: timings,
         files,
         warnings: Vec::new(),

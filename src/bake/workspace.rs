@@ -15,7 +15,9 @@ use std::path::{Path, PathBuf};
 /// In-memory artifacts of a bake.
 #[derive(Default)]
 pub struct Workspace {
-    source: Option<(PathBuf, Manifest)>,
+    /// Where artifacts not made in this run are read from: a baked directory with its manifest,
+    /// or a bake's staging directory (stages linked from the stage cache) without one.
+    source: Option<(PathBuf, Option<Manifest>)>,
     memory_budget: Option<u64>,
     scene: Option<Scene>,
     heightmap: Option<HeightMap>,
@@ -56,9 +58,15 @@ impl Workspace {
     /// A workspace that reads missing artifacts from an existing bake.
     pub fn over_bake(dir: &Path, manifest: Manifest) -> Self {
         Workspace {
-            source: Some((dir.to_path_buf(), manifest)),
+            source: Some((dir.to_path_buf(), Some(manifest))),
             ..Default::default()
         }
+    }
+
+    /// Read artifacts this run has not made from the files in `dir` (a bake being written, into
+    /// which cached stages were linked).
+    pub fn read_missing_from(&mut self, dir: &Path) {
+        self.source = Some((dir.to_path_buf(), None));
     }
 
     /// Set the memory budget stages check their allocations against (`--max-memory`).
@@ -85,7 +93,11 @@ impl Workspace {
     pub fn heightmap(&mut self) -> Result<&HeightMap> {
         if self.heightmap.is_none() {
             let dir = self.require_source(baked::heightmap::FILE)?;
-            let manifest = &self.source.as_ref().unwrap().1;
+            let Some(manifest) = &self.source.as_ref().unwrap().1 else {
+                return Err(Error::Internal(
+                    "height map requested before the load".into(),
+                ));
+            };
             self.heightmap = Some(baked::heightmap::read(&dir, manifest)?);
         }
         Ok(self.heightmap.as_ref().unwrap())
@@ -115,14 +127,15 @@ impl Workspace {
     }
 
     fn source_has(&self, file: &str) -> bool {
-        self.source
-            .as_ref()
-            .is_some_and(|(_, m)| m.file(file).is_some())
+        self.source.as_ref().is_some_and(|(dir, m)| match m {
+            Some(m) => m.file(file).is_some(),
+            None => dir.join(file).is_file(),
+        })
     }
 
     fn require_source(&self, file: &str) -> Result<PathBuf> {
         match &self.source {
-            Some((dir, manifest)) if manifest.file(file).is_some() => Ok(dir.clone()),
+            Some((dir, _)) if self.source_has(file) => Ok(dir.clone()),
             Some((dir, _)) => Err(Error::input(
                 dir,
                 format!("this bake has no `{file}`; run the stage that writes it first (see `relume-bake inspect`)"),

@@ -20,7 +20,7 @@ pub mod npy;
 pub mod patches;
 pub mod permutation;
 pub mod scene;
-mod transaction;
+pub(crate) mod transaction;
 pub mod transport;
 
 pub use manifest::{

@@ -55,7 +55,7 @@ impl BakeTransaction {
 
     /// Write a whole file from bytes.
     pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<()> {
-        let path = self.tmp.join(name);
+        let path = self.fresh_path(name)?;
         std::fs::write(&path, bytes).at(&path, "cannot write")?;
         self.record(name)
     }
@@ -63,7 +63,7 @@ impl BakeTransaction {
     /// Let `f` write the file at the given staging path (for writers that take a path), then
     /// record its size and hash.
     pub fn write_with(&mut self, name: &str, f: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-        let path = self.tmp.join(name);
+        let path = self.fresh_path(name)?;
         f(&path)?;
         self.record(name)
     }
@@ -71,12 +71,26 @@ impl BakeTransaction {
     /// Take a file unchanged from an existing bake (hard link when possible, else copy).
     pub fn carry(&mut self, from_dir: &Path, rec: &FileRecord) -> Result<()> {
         let src = from_dir.join(&rec.name);
-        let dst = self.tmp.join(&rec.name);
+        let dst = self.fresh_path(&rec.name)?;
         if std::fs::hard_link(&src, &dst).is_err() {
             std::fs::copy(&src, &dst).at(&src, "cannot copy")?;
         }
+        self.files.retain(|f| f.name != rec.name);
         self.files.push(rec.clone());
         Ok(())
+    }
+
+    /// The staging path of `name`, with any file already there unlinked first: a carried file is
+    /// a hard link shared with a previous bake or the stage cache, and writing through it would
+    /// change those too.
+    fn fresh_path(&self, name: &str) -> Result<PathBuf> {
+        let path = self.tmp.join(name);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                Err(Error::io(&path, "cannot replace", e))
+            }
+            _ => Ok(path),
+        }
     }
 
     /// Forget a file written earlier in this transaction (a later stage replaced it).
@@ -164,7 +178,7 @@ impl Drop for BakeTransaction {
 pub const LOCK: &str = ".relume-lock";
 
 /// `PID START` of a process (START empty where `/proc` is not there).
-fn owner_tag(pid: u32) -> String {
+pub(crate) fn owner_tag(pid: u32) -> String {
     format!("{pid} {}", start_time(pid).unwrap_or_default())
 }
 
@@ -176,7 +190,7 @@ fn start_time(pid: u32) -> Option<String> {
 }
 
 /// Is the process that wrote `tag` (`PID START`) still running?
-fn owner_alive(tag: &str) -> bool {
+pub(crate) fn owner_alive(tag: &str) -> bool {
     let mut w = tag.split_whitespace();
     let Some(pid) = w.next().and_then(|p| p.parse::<u32>().ok()) else {
         return false;

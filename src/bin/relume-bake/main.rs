@@ -61,6 +61,16 @@ enum Command {
         /// Refuse to start when the estimated peak memory exceeds this (e.g. 512M, 8G; default 75% of RAM)
         #[arg(long, value_name = "SIZE", value_parser = relume::limits::parse_bytes)]
         max_memory: Option<u64>,
+        /// Stage cache: finished stages are kept here, and a re-run redoes only the stages whose
+        /// inputs or knobs changed (default: .relume-cache beside the output)
+        #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+        cache: Option<PathBuf>,
+        /// Neither read nor write the stage cache
+        #[arg(long)]
+        no_cache: bool,
+        /// Run every stage, even when the output is up to date or the cache holds them
+        #[arg(long)]
+        force: bool,
     },
     /// Show the stages a pipeline would run, with estimated peak memory and output size; writes nothing
     Plan {
@@ -163,6 +173,56 @@ fn main() {
     std::process::exit(code);
 }
 
+/// `.relume-cache` in the output's parent directory.
+fn default_cache(out: &Path) -> PathBuf {
+    match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.join(".relume-cache"),
+        _ => PathBuf::from(".relume-cache"),
+    }
+}
+
+/// What `run` tells people: where the bake went, and which stages were reused or skipped.
+fn bake_summary(report: &relume::bake::BakeReport) -> String {
+    let bytes: u64 = report.files.iter().map(|f| f.bytes).sum();
+    let size = relume::limits::human_bytes(bytes);
+    if report.up_to_date {
+        return format!(
+            "up to date: {} already holds this bake ({} files, {size}, all verified); nothing to do\n",
+            report.output.display(),
+            report.files.len() + 1
+        );
+    }
+    let mut s = format!(
+        "baked {} ({} files, {size})\n",
+        report.output.display(),
+        report.files.len() + 1
+    );
+    let cached: Vec<&str> = report
+        .stages
+        .iter()
+        .filter(|t| t.cached)
+        .map(|t| t.stage.as_str())
+        .collect();
+    if !cached.is_empty() {
+        let ran: Vec<&str> = report
+            .stages
+            .iter()
+            .filter(|t| !t.cached && t.stage != "load")
+            .map(|t| t.stage.as_str())
+            .collect();
+        s += &format!(
+            "reused from the stage cache: {}; ran: {}\n",
+            cached.join(", "),
+            if ran.is_empty() {
+                "nothing".to_string()
+            } else {
+                ran.join(", ")
+            }
+        );
+    }
+    s
+}
+
 fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
     let json = cli.global.json;
     match &cli.command {
@@ -170,6 +230,9 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             pipeline,
             out,
             max_memory,
+            cache,
+            no_cache,
+            force,
         } => {
             let p = relume::pipeline::parse_pipeline(pipeline)?;
             let out = relume::pipeline::output_dir(pipeline, &p, out.as_deref());
@@ -177,17 +240,15 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             if let Some(m) = max_memory {
                 opts.max_memory = *m;
             }
+            opts.force = *force;
+            if !no_cache {
+                opts.cache = Some(cache.clone().unwrap_or_else(|| default_cache(&out)));
+            }
             let report = relume::bake::run_pipeline(&p, &out, &opts, ui)?;
             if json {
                 print_json(&report);
             } else if !cli.global.quiet {
-                let bytes: u64 = report.files.iter().map(|f| f.bytes).sum();
-                eprintln!(
-                    "baked {} ({} files, {})",
-                    out.display(),
-                    report.files.len() + 1,
-                    relume::limits::human_bytes(bytes)
-                );
+                eprint!("{}", bake_summary(&report));
             }
             Ok(exit::OK)
         }
