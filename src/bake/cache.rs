@@ -1,7 +1,8 @@
 //! The stage cache: what each finished stage of a bake wrote, kept so that a killed or changed bake
 //! redoes only the stages whose inputs changed.
 //!
-//! A stage's **key** is the SHA-256 of relume's version, the baked format version, the stage's
+//! A stage's **key** is the SHA-256 of relume's version and source fingerprint (`build.rs`: a
+//! different build never reuses another's stages), the baked format version, the stage's
 //! knobs (its RON) and the names and content hashes of every file the bake held before the stage
 //! ran. Stages read nothing but those files (the workspace's artifacts are their decoded
 //! contents) and are deterministic, so equal keys mean byte-identical outputs. The key of the
@@ -68,8 +69,9 @@ impl StageCache {
     /// The key of `stage` run on a bake holding `files`.
     pub fn key(stage: &Stage, files: &[FileRecord]) -> String {
         let mut text = format!(
-            "relume {} format {}\n{}\n",
+            "relume {} source {} format {}\n{}\n",
             env!("CARGO_PKG_VERSION"),
+            env!("RELUME_SOURCE_HASH"),
             baked::FORMAT_VERSION,
             ron::to_string(stage).expect("stage knobs serialise")
         );

@@ -27,4 +27,22 @@ pub struct PlanState {
     pub patches: u64,
     /// Colour channels the transport needs (1 for grey scenes, 3 otherwise).
     pub channels: u64,
+    /// The patch count measured by a voxelize that already ran (replaces the estimate).
+    pub measured_patches: Option<u64>,
+}
+
+/// Sizes measured by the stages that already ran, for planning the rest of a bake.
+#[derive(Clone, Debug, Default)]
+pub struct Measured {
+    /// Patches `voxelize` made.
+    pub patches: Option<u64>,
+}
+
+impl Measured {
+    /// Take what `rec` measured.
+    pub fn observe(&mut self, rec: &crate::baked::StageRecord) {
+        if rec.stage == "voxelize" {
+            self.patches = rec.report.get("patches").map(|&p| p as u64);
+        }
+    }
 }

@@ -7,7 +7,7 @@ pub mod plan;
 pub mod stages;
 pub mod workspace;
 
-pub use estimate::{PlanState, PlannedStage};
+pub use estimate::{Measured, PlanState, PlannedStage};
 pub use plan::{plan, Plan};
 
 use crate::baked::{self, manifest::hash_file, BakeTransaction, FileRecord, Manifest, StageRecord};
@@ -56,6 +56,11 @@ pub struct BakeReport {
     pub stages: Vec<StageTiming>,
     pub files: Vec<FileRecord>,
     pub warnings: Vec<String>,
+    /// The largest peak memory the plan estimated for a stage that ran (re-planned before each
+    /// stage with the sizes measured so far).
+    pub estimated_peak_bytes: u64,
+    /// The process's measured peak resident memory (Linux), for comparison with the estimate.
+    pub peak_rss_bytes: Option<u64>,
 }
 
 /// Wall time and outputs of one stage.
@@ -65,12 +70,20 @@ pub struct StageTiming {
     pub seconds: f64,
     /// Taken from the stage cache instead of run.
     pub cached: bool,
+    /// The plan's peak memory for this stage (re-planned with the sizes measured before it).
+    pub estimated_peak_bytes: u64,
+    /// The process's peak resident memory while the stage ran (Linux; `None` elsewhere).
+    pub peak_rss_bytes: Option<u64>,
     pub outputs: Vec<String>,
     pub report: std::collections::BTreeMap<String, f64>,
 }
 
 /// Bake `pipeline` into `output`. On any error nothing is written and a previous bake at
 /// `output` is left as it was.
+///
+/// Before each stage that runs (is not taken from the cache), the rest of the pipeline is
+/// planned again with the sizes measured so far (the real patch count after voxelize) and the
+/// plan's peak is checked against `opts.max_memory`.
 pub fn run_pipeline(
     pipeline: &Pipeline,
     output: &Path,
@@ -78,6 +91,7 @@ pub fn run_pipeline(
     progress: &dyn Progress,
 ) -> Result<BakeReport> {
     let t0 = Instant::now();
+    limits::baseline_rss();
     progress.begin("load", 0);
     let input = load_input(&pipeline.input)?;
     progress.finish();
@@ -89,23 +103,11 @@ pub fn run_pipeline(
         }
     }
     let mut txn = BakeTransaction::begin(output)?;
-    let mut records = Vec::new();
-    let mut timings = Vec::new();
     let load_record = write_input(&mut txn, &input)?;
-    let (bytes, sha256) = hash_file(pipeline.input.path())?;
-    if !opts.force && up_to_date(output, pipeline, &sha256, &txn.files()) {
-        return Ok(BakeReport {
-            output: output.to_path_buf(),
-            up_to_date: true,
-            stages: Vec::new(),
-            files: Manifest::read(output)?.files,
-            warnings,
-        });
-    }
-    let the_plan = plan(pipeline, &input, output);
-    limits::check_memory("this bake", the_plan.peak_bytes, opts.max_memory)?;
-    timings.push(timing(&load_record, t0, false));
-    records.push(load_record);
+    let mut measured = Measured::default();
+    let mut timings = vec![timing(&load_record, t0, false)];
+    let mut records = vec![load_record];
+    let plan_input = plan::PlanInput::of(&input);
 
     let mut ws = Workspace::new();
     ws.set_memory_budget(opts.max_memory);
@@ -119,8 +121,13 @@ pub fn run_pipeline(
         .as_deref()
         .map(|root| StageCache::open(root, output));
     let mut keys = Vec::new();
-    for stage in &pipeline.stages {
+    let mut estimated_peak =
+        plan::plan_measured(pipeline, &plan_input, output, &measured).stages[0].peak_bytes;
+    timings[0].estimated_peak_bytes = estimated_peak;
+    timings[0].peak_rss_bytes = limits::peak_rss();
+    for (i, stage) in pipeline.stages.iter().enumerate() {
         let t = Instant::now();
+        let mut stage_estimate = 0;
         let before = txn.files();
         let key = StageCache::key(stage, &before);
         let hit = cache
@@ -130,6 +137,13 @@ pub fn run_pipeline(
         let (rec, cached) = match hit {
             Some(hit) => (hit.apply(&mut txn)?, true),
             None => {
+                let rest = plan::plan_measured(pipeline, &plan_input, output, &measured);
+                let peak = rest.peak_from(i + 1);
+                let what = format!("the rest of this bake (from `{}`)", stage.kind().name());
+                limits::check_memory(&what, peak, opts.max_memory)?;
+                estimated_peak = estimated_peak.max(peak);
+                stage_estimate = rest.stages[i + 1].peak_bytes;
+                limits::reset_peak_rss();
                 let rec = runner(stage).run(&mut ws, &mut txn, progress)?;
                 if let Some(c) = &cache {
                     if let Err(e) = c.store(&key, stage, &rec, &before, &txn) {
@@ -141,18 +155,25 @@ pub fn run_pipeline(
                 (rec, false)
             }
         };
+        measured.observe(&rec);
         keys.push(key);
-        timings.push(timing(&rec, t, cached));
+        let mut tm = timing(&rec, t, cached);
+        if !cached {
+            tm.estimated_peak_bytes = stage_estimate;
+            tm.peak_rss_bytes = limits::peak_rss();
+        }
+        timings.push(tm);
         records.push(rec);
     }
 
+    let (bytes, sha256) = hash_file(pipeline.input.path())?;
     let input_name = pipeline
         .input
         .path()
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let manifest = Manifest {
+    let mut manifest = Manifest {
         format_version: baked::FORMAT_VERSION,
         relume_version: env!("CARGO_PKG_VERSION").to_string(),
         pipeline: pipeline.clone(),
@@ -165,35 +186,34 @@ pub fn run_pipeline(
         files: Vec::new(),
     };
     let files = txn.files();
-    txn.commit(manifest)?;
+    let all_cached = cache.is_some() && timings.iter().skip(1).all(|t| t.cached);
+    manifest.files = files.clone();
+    let up_to_date = all_cached && holds(output, &manifest);
+    if up_to_date {
+        drop(txn);
+    } else {
+        txn.commit(manifest)?;
+    }
     if let Some(c) = &cache {
         c.retain(&keys);
     }
+    // Each stage's peak was measured from a reset: the bake's peak is the largest.
+    let peak_rss = timings.iter().filter_map(|t| t.peak_rss_bytes).max();
     Ok(BakeReport {
         output: output.to_path_buf(),
-        up_to_date: false,
-        stages: timings,
+        up_to_date,
+        stages: if up_to_date { Vec::new() } else { timings },
         files,
         warnings,
+        estimated_peak_bytes: estimated_peak,
+        peak_rss_bytes: peak_rss,
     })
 }
 
-/// Does `output` already hold the bake of `pipeline` by this relume, from an input with this
-/// hash whose canonical form (`load_files`) is unchanged, with every file intact?
-fn up_to_date(
-    output: &Path,
-    pipeline: &Pipeline,
-    input_sha256: &str,
-    load_files: &[FileRecord],
-) -> bool {
-    let Ok(m) = Manifest::read(output) else {
-        return false;
-    };
-    m.relume_version == env!("CARGO_PKG_VERSION")
-        && m.pipeline == *pipeline
-        && m.input.sha256 == input_sha256
-        && load_files.iter().all(|f| m.file(&f.name) == Some(f))
-        && baked::manifest::verify(output, &m).is_empty()
+/// Does the baked directory at `output` have exactly this manifest, with every file intact?
+fn holds(output: &Path, manifest: &Manifest) -> bool {
+    Manifest::read(output).is_ok_and(|m| m == *manifest)
+        && baked::manifest::verify(output, manifest).is_empty()
 }
 
 fn timing(record: &StageRecord, since: Instant, cached: bool) -> StageTiming {
@@ -201,6 +221,8 @@ fn timing(record: &StageRecord, since: Instant, cached: bool) -> StageTiming {
         stage: record.stage.clone(),
         seconds: since.elapsed().as_secs_f64(),
         cached,
+        estimated_peak_bytes: 0,
+        peak_rss_bytes: None,
         outputs: record.outputs.clone(),
         report: record.report.clone(),
     }
@@ -336,5 +358,7 @@ pub fn run_stage_on_with(
         stages: timings,
         files,
         warnings: Vec::new(),
+        estimated_peak_bytes: 0,
+        peak_rss_bytes: limits::peak_rss(),
     })
 }

@@ -2,7 +2,7 @@
 //! size, computed from the loaded input without writing anything. `run` checks the same estimate
 //! against `--max-memory` before it allocates.
 
-use super::estimate::{PlanState, PlannedStage};
+use super::estimate::{Measured, PlanState, PlannedStage};
 use super::stages::runner;
 use crate::load::LoadedInput;
 use crate::pipeline::{Pipeline, Stage};
@@ -51,43 +51,107 @@ impl Plan {
             human_bytes(default_max_memory()),
             human_bytes(self.output_bytes)
         );
+        t += &format!(
+            "peaks include relume's own {}; `run` plans the rest again before each stage with the sizes measured so far (the real patch count after voxelize) and stops before a stage that would go over the budget\n",
+            human_bytes(crate::limits::baseline_rss())
+        );
         t
     }
 }
 
-/// Estimate the pipeline on a loaded input.
+/// What the plan needs to know of the loaded input.
+#[derive(Clone, Debug)]
+pub struct PlanInput {
+    state: PlanState,
+    load: PlannedStage,
+}
+
+impl PlanInput {
+    /// Sizes of a loaded input.
+    pub fn of(input: &LoadedInput) -> Self {
+        let mut state = PlanState::default();
+        let load = match input {
+            LoadedInput::Scene(scene, _) => {
+                let v = scene.positions.len() as u64;
+                let t = scene.triangles.len() as u64;
+                state.triangles = t;
+                state.channels = if scene.is_grey() { 1 } else { 3 };
+                let bytes = v * 12 + t * 20 + scene.materials.len() as u64 * 64;
+                state.resident_bytes = bytes;
+                PlannedStage {
+                    stage: "load".into(),
+                    peak_bytes: bytes * 2,
+                    output_bytes: bytes,
+                    notes: format!("{v} vertices, {t} triangles"),
+                }
+            }
+            LoadedInput::HeightMap(map, info) => {
+                let texels = (map.width * map.height) as u64;
+                let [w, h] = info.source_size;
+                state.map_size = (map.width as u64, map.height as u64);
+                state.resident_bytes = texels * 4;
+                // The decoded samples, their f64 copy, the f32 heights and the validity mask of
+                // the file's whole grid, and the downsampled map when there is one.
+                let sample_bytes = match info.sample.as_str() {
+                    "u8" => 1,
+                    "u16" | "i16" => 2,
+                    "f32" | "i32" | "u32" => 4,
+                    _ => 8,
+                };
+                PlannedStage {
+                    stage: "load".into(),
+                    peak_bytes: (w * h) as u64 * (13 + sample_bytes)
+                        + if texels < (w * h) as u64 {
+                            texels * 4
+                        } else {
+                            0
+                        },
+                    output_bytes: texels * 4,
+                    notes: format!("{}x{} texels (file {w}x{h})", map.width, map.height),
+                }
+            }
+        };
+        PlanInput { state, load }
+    }
+}
+
+impl Plan {
+    /// The largest peak of the plan's stages from index `first` on (0 is the load).
+    pub fn peak_from(&self, first: usize) -> u64 {
+        self.stages
+            .iter()
+            .skip(first)
+            .map(|s| s.peak_bytes)
+            .max()
+            .unwrap_or(0)
+    }
+}
+
+/// Estimate the pipeline on a loaded input, before any stage ran.
 pub fn plan(pipeline: &Pipeline, input: &LoadedInput, output: &Path) -> Plan {
-    let mut state = PlanState::default();
-    let load = match input {
-        LoadedInput::Scene(scene, _) => {
-            let v = scene.positions.len() as u64;
-            let t = scene.triangles.len() as u64;
-            state.triangles = t;
-            state.channels = if scene.is_grey() { 1 } else { 3 };
-            let bytes = v * 12 + t * 20 + scene.materials.len() as u64 * 64;
-            state.resident_bytes = bytes;
-            PlannedStage {
-                stage: "load".into(),
-                peak_bytes: bytes * 2,
-                output_bytes: bytes,
-                notes: format!("{v} vertices, {t} triangles"),
-            }
-        }
-        LoadedInput::HeightMap(map, _) => {
-            let texels = (map.width * map.height) as u64;
-            state.map_size = (map.width as u64, map.height as u64);
-            state.resident_bytes = texels * 4;
-            PlannedStage {
-                stage: "load".into(),
-                peak_bytes: texels * 13,
-                output_bytes: texels * 4,
-                notes: format!("{}x{} texels", map.width, map.height),
-            }
-        }
-    };
-    let mut stages = vec![load];
+    plan_measured(
+        pipeline,
+        &PlanInput::of(input),
+        output,
+        &Measured::default(),
+    )
+}
+
+/// Estimate the pipeline with what the stages that already ran measured.
+pub fn plan_measured(
+    pipeline: &Pipeline,
+    input: &PlanInput,
+    output: &Path,
+    measured: &Measured,
+) -> Plan {
+    let mut state = input.state.clone();
+    state.measured_patches = measured.patches;
+    let mut stages = vec![input.load.clone()];
     for stage in &pipeline.stages {
         stages.push(estimate(stage, &mut state));
+    }
+    for s in &mut stages {
+        s.peak_bytes += crate::limits::baseline_rss();
     }
     Plan {
         input: pipeline.input.path().display().to_string(),

@@ -73,6 +73,8 @@ pub struct HeightMapInfo {
     pub nodata_count: usize,
     /// Where the cell size came from (`option`, `world-file`, `geotiff-tag`, `default`).
     pub cell_size_source: String,
+    /// Width and height of the file's grid (before `downsample`).
+    pub source_size: [usize; 2],
 }
 
 /// Raw decoded samples before scaling and no-data handling.
@@ -167,6 +169,7 @@ pub fn load_heightmap(path: &Path, opts: &HeightMapOptions) -> Result<(HeightMap
         sample: raw.sample.into(),
         nodata_count,
         cell_size_source: cell_size_source.into(),
+        source_size: [raw.width, raw.height],
     };
     Ok((map, info))
 }

@@ -24,6 +24,7 @@ pub mod overlap;
 pub mod reference;
 pub mod transport;
 pub mod visibility;
+pub mod voxel_size;
 pub mod voxelize;
 
 pub use matrix::TransportMatrix;

@@ -20,6 +20,7 @@
 use super::geometry::{self, axis_vector, dominant_axis, group_key, split_key, Frame, Polygon};
 use super::overlap::{self, Face};
 use super::visibility::Visibility;
+use super::voxel_size::SizeSearch;
 use super::{Patch, PatchLists, PatchSet, Piece, SurfacePoint, VoxelizeStats};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
@@ -54,6 +55,15 @@ const SAMPLE_SEED: u64 = 0x5a3b_1e5e;
 
 /// Simplify `scene` into patches. Preconditions: the scene passed [`Scene::validate`].
 pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
+    voxelize_noting(scene, params).map(|(set, _)| set)
+}
+
+/// [`voxelize`], with why `TargetPatches(n)` could not come within 20 % of `n` when it could not
+/// ([`super::voxel_size`]).
+pub fn voxelize_noting(
+    scene: &Scene,
+    params: &VoxelizeParams,
+) -> Result<(PatchSet, Option<String>)> {
     let live = live_triangles(scene);
     let degenerate = scene.triangles.len() - live.len();
     if live.is_empty() {
@@ -91,76 +101,49 @@ pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
         .collect();
     let visible = overlap::visible_parts(&faces, tolerance);
 
+    let mut note = None;
     let size = match params.resolution {
         Resolution::VoxelSize(s) => s,
-        Resolution::TargetPatches(n) => choose_voxel_size(&faces, &visible.polygons, extent, n),
+        Resolution::TargetPatches(n) => {
+            let search = SizeSearch {
+                scene,
+                live: &live,
+                faces: &faces,
+                polys: &visible.polygons,
+                origin: lo,
+                extent,
+            };
+            let choice = search.for_target(n);
+            note = choice.note;
+            choice.size
+        }
     };
-    let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
-    if !(size.is_finite() && size > 0.0) || dims_f.x * dims_f.y * dims_f.z > MAX_VOXELS {
+    let Some(dims) = grid_dims(extent, size) else {
+        let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
         return Err(Error::knob(format!(
             "voxel size {size} gives a grid of {:.0} x {:.0} x {:.0} voxels for a scene of extent {:?}; use a larger voxel size or a smaller target patch count",
             dims_f.x, dims_f.y, dims_f.z, extent.to_array()
         )));
-    }
-    let dims = [dims_f.x as u32, dims_f.y as u32, dims_f.z as u32];
+    };
     let frame = Frame {
         origin: lo,
         scale: size,
     };
 
-    // Clip every visible polygon into voxels, in grid coordinates.
-    let mut pieces: Vec<(u64, Piece)> = Vec::new();
-    for (k, &t) in live.iter().enumerate() {
-        let axis = dominant_axis(faces[k].normal);
-        for poly in &visible.polygons[k] {
-            let grid: Polygon = poly.iter().map(|&p| p / size).collect();
-            for (voxel, piece) in clip_to_voxels(&grid, dims) {
-                let area = geometry::area(&piece);
-                if area > MIN_PIECE_AREA {
-                    let key = group_key(voxel, axis, dims);
-                    pieces.push((
-                        key,
-                        Piece {
-                            triangle: t,
-                            normal: faces[k].normal.to_array(),
-                            vertices: piece.iter().map(|p| p.to_array()).collect(),
-                            area,
-                        },
-                    ));
-                }
-            }
-        }
-    }
-    pieces.sort_by_key(|(key, p)| (*key, p.triangle)); // stable: keeps clipping order
-
+    let pieces = clip_pieces(&live, &faces, &visible.polygons, size, dims);
     let extent_grid = dims.iter().copied().max().unwrap_or(1) as f64;
     let vis = Visibility::new(scene, &live, &frame, extent_grid);
-    let lift = 4.0 * vis.epsilon as f64;
 
-    // Group by key, split each group into mutually visible clusters, one patch per cluster.
+    // One patch per cluster of mutually visible pieces of a (voxel, axis) group.
     let mut set = PatchSet {
         voxel_size: size,
         origin: lo.to_array(),
         dims,
         ..Default::default()
     };
-    let mut start = 0;
-    while start < pieces.len() {
-        let key = pieces[start].0;
-        let end = start + pieces[start..].iter().take_while(|p| p.0 == key).count();
-        let mut clusters: Vec<(DVec3, Vec<usize>)> = Vec::new();
-        for (i, (_, p)) in pieces.iter().enumerate().take(end).skip(start) {
-            let c = lifted_centroid(p, lift);
-            match clusters.iter_mut().find(|(rep, _)| !vis.occluded(c, *rep)) {
-                Some((_, members)) => members.push(i),
-                None => clusters.push((c, vec![i])),
-            }
-        }
-        for (_, members) in clusters {
-            let patch = build_patch(scene, &frame, key, dims, &members, &pieces, &mut set);
-            set.patches.push(patch);
-        }
-        start = end;
+    for (key, members) in clusters(&pieces, &vis) {
+        let patch = build_patch(scene, &frame, key, dims, &members, &pieces, &mut set);
+        set.patches.push(patch);
     }
 
     // Direct-light sample points and the triangle → patch map.
@@ -191,7 +174,7 @@ pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
             .filter(|&c| set.corners.list(c).0.is_empty())
             .count() as u32,
     };
-    Ok(set)
+    Ok((set, note))
 }
 
 /// The scene's non-degenerate triangles (the ones the bake uses), in scene order.
@@ -200,6 +183,73 @@ pub fn live_triangles(scene: &Scene) -> Vec<u32> {
     (0..scene.triangles.len() as u32)
         .filter(|t| !degenerate.contains(&(*t as usize)))
         .collect()
+}
+
+/// The grid of voxel `size` over a scene of `extent`, or `None` when it is not finite or larger
+/// than [`MAX_VOXELS`].
+pub(super) fn grid_dims(extent: DVec3, size: f64) -> Option<[u32; 3]> {
+    let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
+    (size.is_finite() && size > 0.0 && dims_f.x * dims_f.y * dims_f.z <= MAX_VOXELS)
+        .then(|| [dims_f.x as u32, dims_f.y as u32, dims_f.z as u32])
+}
+
+/// Every visible polygon of the `live` triangles clipped into the voxels of a `dims` grid of
+/// voxel `size` (grid coordinates), keyed by (voxel, axis) group and sorted by (group, triangle),
+/// clipping order kept within a triangle.
+pub(super) fn clip_pieces(
+    live: &[u32],
+    faces: &[Face],
+    polys: &[Vec<Polygon>],
+    size: f64,
+    dims: [u32; 3],
+) -> Vec<(u64, Piece)> {
+    let mut pieces: Vec<(u64, Piece)> = Vec::new();
+    for (k, &t) in live.iter().enumerate() {
+        let axis = dominant_axis(faces[k].normal);
+        for poly in &polys[k] {
+            let grid: Polygon = poly.iter().map(|&p| p / size).collect();
+            for (voxel, piece) in clip_to_voxels(&grid, dims) {
+                let area = geometry::area(&piece);
+                if area > MIN_PIECE_AREA {
+                    pieces.push((
+                        group_key(voxel, axis, dims),
+                        Piece {
+                            triangle: t,
+                            normal: faces[k].normal.to_array(),
+                            vertices: piece.iter().map(|p| p.to_array()).collect(),
+                            area,
+                        },
+                    ));
+                }
+            }
+        }
+    }
+    pieces.sort_by_key(|(key, p)| (*key, p.triangle)); // stable: keeps clipping order
+    pieces
+}
+
+/// Split each group of `pieces` (sorted by key) into clusters that see each other: a piece joins
+/// the first cluster whose representative (its first piece's lifted centroid) it sees. One
+/// cluster is one patch.
+pub(super) fn clusters(pieces: &[(u64, Piece)], vis: &Visibility) -> Vec<(u64, Vec<usize>)> {
+    let lift = 4.0 * vis.epsilon as f64;
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < pieces.len() {
+        let key = pieces[start].0;
+        let end = start + pieces[start..].iter().take_while(|p| p.0 == key).count();
+        let mut group: Vec<(DVec3, Vec<usize>)> = Vec::new();
+        for (i, (_, p)) in pieces.iter().enumerate().take(end).skip(start) {
+            let c = lifted_centroid(p, lift);
+            match group.iter_mut().find(|(rep, _)| !vis.occluded(c, *rep)) {
+                Some((_, members)) => members.push(i),
+                None => group.push((c, vec![i])),
+            }
+        }
+        out.extend(group.into_iter().map(|(_, m)| (key, m)));
+        start = end;
+    }
+    out
 }
 
 fn lifted_centroid(p: &Piece, lift: f64) -> DVec3 {
@@ -320,61 +370,6 @@ fn triangle_map(scene: &Scene, set: &PatchSet, size: f64) -> PatchLists {
         }
     }
     PatchLists::from_lists(per)
-}
-
-/// Bisect the voxel size (in log space) so that the number of (voxel, axis) groups is closest
-/// to `target`.
-fn choose_voxel_size(faces: &[Face], polys: &[Vec<Polygon>], extent: DVec3, target: u32) -> f64 {
-    let total: f64 = polys.iter().flatten().map(|p| geometry::area(p)).sum();
-    let count = |size: f64| -> u64 {
-        let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
-        if dims_f.x * dims_f.y * dims_f.z > MAX_VOXELS {
-            return u64::MAX;
-        }
-        let dims = [dims_f.x as u32, dims_f.y as u32, dims_f.z as u32];
-        let mut keys = Vec::new();
-        for (k, list) in polys.iter().enumerate() {
-            let axis = dominant_axis(faces[k].normal);
-            for poly in list {
-                let grid: Polygon = poly.iter().map(|&p| p / size).collect();
-                for (v, piece) in clip_to_voxels(&grid, dims) {
-                    if geometry::area(&piece) > MIN_PIECE_AREA {
-                        keys.push(group_key(v, axis, dims));
-                    }
-                }
-            }
-        }
-        keys.sort_unstable();
-        keys.dedup();
-        keys.len() as u64
-    };
-    let target = target.max(1) as f64;
-    let guess = (total / target).sqrt().max(extent.max_element() * 1e-6);
-    let (mut small, mut large) = (guess / 4.0, guess * 4.0);
-    while count(small) < target as u64 && small > guess * 1e-6 {
-        small /= 4.0;
-    }
-    while count(large) > target as u64 && large < guess * 1e6 {
-        large *= 4.0;
-    }
-    let mut best = (f64::INFINITY, guess);
-    for _ in 0..30 {
-        let mid = (small * large).sqrt();
-        let c = count(mid);
-        let miss = (c as f64 - target).abs();
-        if miss < best.0 {
-            best = (miss, mid);
-        }
-        if c as f64 > target {
-            small = mid;
-        } else {
-            large = mid;
-        }
-        if large / small < 1.0 + 1e-6 {
-            break;
-        }
-    }
-    best.1
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use crate::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
 use crate::progress::Progress;
 use crate::radiosity::formfactor::form_factors;
 use crate::radiosity::transport::{memory_estimate, transport, TransportParams};
-use crate::radiosity::voxelize::{voxelize, Resolution};
+use crate::radiosity::voxelize::{voxelize_noting, Resolution};
 
 impl StageRun for VoxelizeKnobs {
     fn run(
@@ -20,8 +20,14 @@ impl StageRun for VoxelizeKnobs {
     ) -> Result<StageRecord> {
         let scene = ws.scene()?;
         progress.begin("voxelize", 0);
-        let set = voxelize(scene, &self.params())?;
+        let (set, note) = voxelize_noting(scene, &self.params())?;
         progress.finish();
+        if let (Resolution::TargetPatches(n), Some(why)) = (self.resolution, &note) {
+            progress.warn(&format!(
+                "voxelize: TargetPatches({n}) gave {} patches: {why}",
+                set.len()
+            ));
+        }
         let s = &set.stats;
         if s.degenerate_triangles > 0 {
             progress.warn(&format!(
@@ -58,6 +64,9 @@ impl StageRun for VoxelizeKnobs {
             rec.report.insert(k.into(), v);
         }
         rec.facts.insert("grey".into(), set.is_grey().to_string());
+        if let Some(why) = note {
+            rec.facts.insert("target_missed".into(), why);
+        }
         rec.facts.insert(
             "units".into(),
             "scene units (after the input's scale)".into(),
@@ -67,9 +76,13 @@ impl StageRun for VoxelizeKnobs {
     }
 
     fn estimate(&self, state: &mut PlanState) -> PlannedStage {
-        let (patches, note) = match self.resolution {
-            Resolution::TargetPatches(n) => (n as u64, format!("about {n} patches")),
-            Resolution::VoxelSize(s) => (
+        let (patches, note) = match (state.measured_patches, self.resolution) {
+            (Some(p), _) => (p, format!("{p} patches (measured)")),
+            (None, Resolution::TargetPatches(n)) => (
+                n as u64,
+                format!("assumes TargetPatches({n}) gives {n} patches; re-checked after voxelize"),
+            ),
+            (None, Resolution::VoxelSize(s)) => (
                 state.triangles.max(1000),
                 format!(
                     "voxel size {s}: patch count known after voxelizing (assumed {})",

@@ -150,6 +150,7 @@ impl LoadKnobs {
 }
 
 fn main() {
+    relume::limits::tune_allocator();
     restore_sigpipe();
     let cli = Cli::parse();
     if let Some(n) = cli.global.threads {
@@ -255,6 +256,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         Command::Plan { pipeline, out } => {
             let p = relume::pipeline::parse_pipeline(pipeline)?;
             let out = relume::pipeline::output_dir(pipeline, &p, out.as_deref());
+            relume::limits::baseline_rss();
             let input = relume::load::load_input(&p.input)?;
             let plan = relume::bake::plan(&p, &input, &out);
             if json {
