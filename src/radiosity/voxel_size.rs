@@ -19,7 +19,7 @@
 use super::geometry::{self, Frame, Polygon};
 use super::overlap::Face;
 use super::visibility::Visibility;
-use super::voxelize::{clip_pieces, clusters, grid_dims};
+use super::clip::{clip_pieces, clusters, grid_dims};
 use crate::scene::Scene;
 use glam::DVec3;
 
