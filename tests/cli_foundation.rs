@@ -76,6 +76,7 @@ fn run_writes_a_verified_bake_and_inspect_detects_damage() {
         &[
             "run",
             "--quiet",
+            "--no-cache",
             data("pipelines/bigtujunga.ron").to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
@@ -197,6 +198,7 @@ fn plan_writes_nothing_and_run_respects_the_memory_budget() {
         &[
             "run",
             "-q",
+            "--no-cache",
             data("pipelines/puget-sound.ron").to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
@@ -209,6 +211,7 @@ fn plan_writes_nothing_and_run_respects_the_memory_budget() {
         &[
             "run",
             "-q",
+            "--no-cache",
             "--max-memory",
             "1M",
             data("pipelines/puget-sound.ron").to_str().unwrap(),

@@ -188,30 +188,48 @@ fn one_huge_entry_among_tiny_ones() {
     }
 }
 
+const TOL_F16: f64 = 6e-4;
+const TOL_BC6H: f64 = 0.23;
+const TOL_BC1: f64 = 0.23;
+const TOL_BC4: f64 = 0.33;
+
+/// Largest RMS relative gather error over n = 1, 3, 5, both channel counts and the standard
+/// lights, measured per encoding (`cargo test --release --test compress_lib padding -- --nocapture`
+/// prints them): F32 0, F16 1.48e-4, BC6H 5.82e-2, BC1-log 5.72e-2, BC4-log 8.18e-2.
+/// The tolerances allow 4x that (F32: exact up to f32 summation order).
+fn padding_tolerance(enc: DenseEncoding) -> f64 {
+    match enc {
+        DenseEncoding::F32 => 1e-6,
+        DenseEncoding::F16 => TOL_F16,
+        DenseEncoding::Bc6h => TOL_BC6H,
+        DenseEncoding::Bc1Log => TOL_BC1,
+        DenseEncoding::Bc4Log => TOL_BC4,
+    }
+}
+
 #[test]
 fn padding_for_n_1_3_5() {
-    for n in [1usize, 3, 5] {
-        for ch in [1, 3] {
-            let s = smooth(ch, n);
-            for enc in DenseEncoding::ALL {
+    for enc in DenseEncoding::ALL {
+        let mut worst: f64 = 0.0;
+        for n in [1usize, 3, 5] {
+            for ch in [1, 3] {
+                let s = smooth(ch, n);
                 let e = compress(&s, identity(n), 0.0, &opts(enc)).unwrap();
                 assert_eq!(e.dense.padded, 4 * n.div_ceil(4));
                 e.dense.validate().unwrap();
                 for (name, light) in standard_lights(ch, n) {
                     let exact = s.mat_vec(&light);
                     let b = gather(&e, &light);
-                    let tol = match enc {
-                        DenseEncoding::F32 => 1e-6,
-                        DenseEncoding::F16 => 1e-3,
-                        _ => 0.3,
-                    };
+                    let err = rms_relative(&b, &exact);
+                    worst = worst.max(err);
                     assert!(
-                        rms_relative(&b, &exact) <= tol,
-                        "n {n} ch {ch} {enc:?} {name}: {b:?} vs {exact:?}"
+                        err <= padding_tolerance(enc),
+                        "n {n} ch {ch} {enc:?} {name}: error {err} ({b:?} vs {exact:?})"
                     );
                 }
             }
         }
+        eprintln!("padding: {enc:?} worst RMS relative error {worst:.3e}");
     }
 }
 

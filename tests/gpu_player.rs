@@ -172,9 +172,9 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
         outliers * 100.0
     );
     // Rasterisation and ray casting disagree only on a few silhouette pixels (measured on
-    // lavapipe: 0.011/255 mean, 0.03 % of pixels).
-    assert!(mean_err < 0.5, "mean error {mean_err}");
-    assert!(outliers < 0.01, "outliers {outliers}");
+    // lavapipe, Mesa 22.3.6: 0.012/255 mean, 0.03 % of pixels); 4x margin.
+    assert!(mean_err < 0.048, "mean error {mean_err}");
+    assert!(outliers < 0.0012, "outliers {outliers}");
 }
 
 #[test]
@@ -216,9 +216,9 @@ fn punctual_lights_with_shadow_maps_match_ray_traced_shadows() {
     let (mean_err, outliers) = compare(&gpu_img, &reference, 24);
     eprintln!("glTF room GPU vs CPU reference: mean abs error {mean_err:.3}/255, {:.2} % pixels off by > 24", outliers * 100.0);
     // Shadow maps (2048², 2x2 PCF, normal offset) against exact shadow rays differ on shadow
-    // edges only (measured on lavapipe: 0.023/255 mean, 0.02 % of pixels).
-    assert!(mean_err < 1.0, "mean error {mean_err}");
-    assert!(outliers < 0.01, "outliers {outliers}");
+    // edges only (measured on lavapipe, Mesa 22.3.6: 0.023/255 mean, 0.02 % of pixels); 4x margin.
+    assert!(mean_err < 0.092, "mean error {mean_err}");
+    assert!(outliers < 0.0008, "outliers {outliers}");
     // Shadows are really there: turning them off changes the image.
     player
         .render(

@@ -54,18 +54,24 @@ fn setting<'a>(s: &'a Value, label: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no setting {label} in {}", s["name"]))
 }
 
+/// RMS relative error of the light gathered with `pairwise 16` form factors against the
+/// `hemisphere 4096` reference in the quick radiosity study: 4x the 0.065 measured.
+const PAIRWISE_VS_REFERENCE: f64 = 0.26;
+
 fn err(s: &Value, quantity: &str, metric: &str) -> f64 {
     s["errors"][quantity][metric]
         .as_f64()
         .unwrap_or_else(|| panic!("{quantity}.{metric} of {}", s["label"]))
 }
 
-/// Every error number, time and byte count is finite and non-negative; a reference setting
-/// has error exactly 0 in every quantity and metric.
+/// Every error number and byte count is finite and non-negative and every setting took
+/// measurable time. (A reference's error against itself is 0 by construction and not checked:
+/// each sweep's test checks its reference against an independent value instead.)
 fn check_numbers(j: &Value) {
     for sw in j["sweeps"].as_array().unwrap() {
         for s in settings(sw) {
-            assert!(s["seconds"].as_f64().unwrap() >= 0.0);
+            let t = s["seconds"].as_f64().unwrap();
+            assert!(t > 0.0 && t.is_finite(), "{} took {t} s", s["label"]);
             assert!(s["bytes"].as_u64().is_some());
             for (q, e) in s["errors"].as_object().unwrap() {
                 for (m, v) in e.as_object().unwrap() {
@@ -73,9 +79,6 @@ fn check_numbers(j: &Value) {
                         .as_f64()
                         .unwrap_or_else(|| panic!("{q}.{m} of {} is not a number", s["label"]));
                     assert!(v.is_finite() && v >= 0.0, "{q}.{m} of {} = {v}", s["label"]);
-                    if s["reference"] == true {
-                        assert_eq!(v, 0.0, "reference {} has {q}.{m} = {v}", s["label"]);
-                    }
                 }
             }
         }
@@ -153,10 +156,15 @@ fn radiosity_quick_sweeps_patches_estimators_and_bounces() {
     );
     let r = setting(e, "hemisphere 4096");
     assert_eq!(r["reference"], true);
-    assert_eq!(err(r, "form_factors", "sum"), 0.0);
     // More rays, less error (against a reference 4x denser than the densest swept).
     let f = |l| err(setting(e, l), "form_factors", "sum");
     assert!(f("hemisphere 64") > f("hemisphere 256") && f("hemisphere 256") > f("hemisphere 1024"));
+    // The reference against an independent estimator: pairwise area-to-area integration shares no
+    // rays with the hemisphere, and the light gathered with its form factors (16² samples per
+    // pair) lands within PAIRWISE_VS_REFERENCE of the reference's.
+    let pairwise = err(setting(e, "pairwise 16"), "gathered_light", "rms_rel");
+    eprintln!("pairwise 16 vs the hemisphere-4096 reference: gathered light {pairwise:.4e}");
+    assert!(pairwise < PAIRWISE_VS_REFERENCE, "{pairwise}");
 
     let b = sweep(&j, "radiosity_bounces");
     assert_eq!(

@@ -121,6 +121,7 @@ pub fn run_pipeline(
         .as_deref()
         .map(|root| StageCache::open(root, output));
     let mut keys = Vec::new();
+    let mut ran_any = false;
     let mut estimated_peak =
         plan::plan_measured(pipeline, &plan_input, output, &measured).stages[0].peak_bytes;
     timings[0].estimated_peak_bytes = estimated_peak;
@@ -138,7 +139,9 @@ pub fn run_pipeline(
             Some(hit) => (hit.apply(&mut txn)?, true),
             None => {
                 let rest = plan::plan_measured(pipeline, &plan_input, output, &measured);
-                let peak = rest.peak_from(i + 1);
+                // The first stage that runs answers for the load too.
+                let peak = rest.peak_from(if ran_any { i + 1 } else { 0 });
+                ran_any = true;
                 let what = format!("the rest of this bake (from `{}`)", stage.kind().name());
                 limits::check_memory(&what, peak, opts.max_memory)?;
                 estimated_peak = estimated_peak.max(peak);

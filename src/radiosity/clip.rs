@@ -126,4 +126,3 @@ fn slabs(poly: Polygon, axis: usize, dim: u32) -> Vec<(u32, Polygon)> {
     out.push((i1, rest));
     out
 }
-

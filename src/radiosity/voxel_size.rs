@@ -16,10 +16,10 @@
 //! split a scene into more than `n` clusters, and the count can jump between two sizes closer
 //! than the search resolves. [`SizeChoice::note`] then says which, for the stage to report.
 
+use super::clip::{clip_pieces, clusters, grid_dims};
 use super::geometry::{self, Frame, Polygon};
 use super::overlap::Face;
 use super::visibility::Visibility;
-use super::clip::{clip_pieces, clusters, grid_dims};
 use crate::scene::Scene;
 use glam::DVec3;
 

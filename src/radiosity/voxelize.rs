@@ -17,10 +17,10 @@
 //! The voxel size is a knob, or it is chosen by bisection so that the number of (voxel, axis)
 //! groups is closest to a target patch count.
 
+use super::clip::{clip_pieces, clusters, grid_dims, SNAP};
 use super::geometry::{self, axis_vector, split_key, Frame};
 use super::overlap::{self, Face};
 use super::visibility::Visibility;
-use super::clip::{clip_pieces, clusters, grid_dims, SNAP};
 use super::voxel_size::SizeSearch;
 use super::{Patch, PatchLists, PatchSet, Piece, SurfacePoint, VoxelizeStats};
 use crate::error::{Error, Result};
@@ -260,6 +260,7 @@ fn triangle_map(scene: &Scene, set: &PatchSet, size: f64) -> PatchLists {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::radiosity::geometry::group_key;
 
     #[test]
     fn clipping_covers_the_polygon_exactly() {
