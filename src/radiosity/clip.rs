@@ -19,8 +19,11 @@ pub(super) const SNAP: f64 = 1e-6;
 /// than [`MAX_VOXELS`].
 pub(super) fn grid_dims(extent: DVec3, size: f64) -> Option<[u32; 3]> {
     let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
-    (size.is_finite() && size > 0.0 && dims_f.x * dims_f.y * dims_f.z <= MAX_VOXELS)
-        .then(|| [dims_f.x as u32, dims_f.y as u32, dims_f.z as u32])
+    (size.is_finite() && size > 0.0 && dims_f.x * dims_f.y * dims_f.z <= MAX_VOXELS).then_some([
+        dims_f.x as u32,
+        dims_f.y as u32,
+        dims_f.z as u32,
+    ])
 }
 
 /// Every visible polygon of the `live` triangles clipped into the voxels of a `dims` grid of

@@ -39,6 +39,9 @@ pub(super) struct SizeSearch<'a> {
     pub extent: DVec3,
 }
 
+/// A voxel size tried and the patch count it gave.
+type Tried = (f64, u64);
+
 /// The voxel size chosen, the patch count it gives, and why the count is not closer to the
 /// target when it is off by more than 20 %.
 #[derive(Clone, Debug)]
@@ -119,7 +122,7 @@ impl SizeSearch<'_> {
         let mut size = self.by_groups(n).min(coarsest);
         let mut best: Option<(f64, f64, u64)> = None;
         // Finest size known to give too many patches, coarsest known to give too few.
-        let (mut fine, mut coarse): (Option<(f64, u64)>, Option<(f64, u64)>) = (None, None);
+        let (mut fine, mut coarse): (Option<Tried>, Option<Tried>) = (None, None);
         for _ in 0..MAX_EVALUATIONS {
             let c = self.patches_at(size);
             let miss = (c as f64 - n).abs() / n;
