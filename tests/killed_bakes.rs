@@ -4,10 +4,10 @@
 
 mod common;
 
-use common::{bake, data, expect_code};
+use common::{bake, bake_killed_after, data, expect_code};
 use std::path::Path;
 use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 fn leftovers(parent: &Path) -> Vec<String> {
     std::fs::read_dir(parent)
@@ -54,14 +54,8 @@ fn twenty_kills_spread_over_every_stage_leave_the_previous_bake_and_no_leftovers
     let mut left_behind = 0;
     for k in 0..kills {
         let at = full * (k as f64 + 0.5) / kills as f64;
-        let mut child = Command::new(env!("CARGO_BIN_EXE_relume-bake"))
-            .args(["-q", "run", ps, "--force", "--no-cache", "--out", os])
-            .current_dir(tmp.path())
-            .spawn()
-            .unwrap();
-        std::thread::sleep(Duration::from_secs_f64(at));
-        let _ = child.kill();
-        let _ = child.wait();
+        let args = ["-q", "run", ps, "--force", "--no-cache", "--out", os];
+        bake_killed_after(tmp.path(), &args, at);
         left_behind += leftovers(tmp.path()).len().min(1);
         // Whatever was interrupted, the output is a whole bake that verifies.
         expect_code(&bake(tmp.path(), &["inspect", os]), 0);

@@ -4,10 +4,9 @@
 
 mod common;
 
-use common::{bake, data, expect_code, list_files};
+use common::{bake, bake_killed_after, data, expect_code, list_files};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// A Cornell bake of a few seconds with the given `Encode` knobs.
 fn pipeline(dir: &Path, name: &str, encode: &str) -> PathBuf {
@@ -53,6 +52,21 @@ fn run_json(cwd: &Path, args: &[&str]) -> (Vec<String>, Vec<String>, bool) {
     (cached, ran, v["up_to_date"].as_bool().unwrap())
 }
 
+/// Bake `pipeline` into `dir/name` without the stage cache.
+fn uncached_bake(dir: &Path, pipeline: &Path, name: &str) -> PathBuf {
+    let out = dir.join(name);
+    let args = [
+        "-q",
+        "run",
+        pipeline.to_str().unwrap(),
+        "--no-cache",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    expect_code(&bake(dir, &args), 0);
+    out
+}
+
 fn same_bake(a: &Path, b: &Path) {
     let (ca, cb) = (contents(a), contents(b));
     let names = |c: &[(String, Vec<u8>)]| c.iter().map(|x| x.0.clone()).collect::<Vec<_>>();
@@ -72,22 +86,8 @@ fn a_killed_bake_resumes_from_its_finished_stages_and_equals_an_uninterrupted_on
     let tmp = tempfile::tempdir().unwrap();
     let p = pipeline(tmp.path(), "box.ron", "");
     let ps = p.to_str().unwrap();
-    let reference = tmp.path().join("reference");
     let t0 = Instant::now();
-    expect_code(
-        &bake(
-            tmp.path(),
-            &[
-                "-q",
-                "run",
-                ps,
-                "--no-cache",
-                "--out",
-                reference.to_str().unwrap(),
-            ],
-        ),
-        0,
-    );
+    let reference = uncached_bake(tmp.path(), &p, "reference");
     let full = t0.elapsed().as_secs_f64();
     let out = tmp.path().join("out");
     let os = out.to_str().unwrap();
@@ -100,14 +100,11 @@ fn a_killed_bake_resumes_from_its_finished_stages_and_equals_an_uninterrupted_on
         let _ = std::fs::remove_dir_all(&out);
         let _ = std::fs::remove_dir_all(&cache);
         let at = full * (0.35 + 0.6 * k as f64 / 5.0);
-        let mut child = Command::new(env!("CARGO_BIN_EXE_relume-bake"))
-            .args(["-q", "run", ps, "--out", os, "--cache", cs])
-            .current_dir(tmp.path())
-            .spawn()
-            .unwrap();
-        std::thread::sleep(Duration::from_secs_f64(at));
-        let _ = child.kill();
-        let _ = child.wait();
+        bake_killed_after(
+            tmp.path(),
+            &["-q", "run", ps, "--out", os, "--cache", cs],
+            at,
+        );
         let (cached, _, up_to_date) = run_json(tmp.path(), &[ps, "--out", os, "--cache", cs]);
         if !up_to_date {
             resumed_stages += cached.len();
@@ -162,22 +159,7 @@ fn only_the_stages_whose_inputs_changed_run_again() {
     let (cached, ran, _) = run_json(tmp.path(), &[b.to_str().unwrap(), "--out", os]);
     assert_eq!(cached, ["voxelize", "form_factors", "transport", "reorder"]);
     assert_eq!(ran, ["load", "encode"]);
-    let fresh = tmp.path().join("fresh");
-    expect_code(
-        &bake(
-            tmp.path(),
-            &[
-                "-q",
-                "run",
-                b.to_str().unwrap(),
-                "--no-cache",
-                "--out",
-                fresh.to_str().unwrap(),
-            ],
-        ),
-        0,
-    );
-    same_bake(&out, &fresh);
+    same_bake(&out, &uncached_bake(tmp.path(), &b, "fresh"));
 
     // The cache keeps only the stages of the bake just made: going back to `a` reruns encode.
     let (cached, ran, _) = run_json(tmp.path(), &[a.to_str().unwrap(), "--out", os]);
@@ -212,22 +194,7 @@ fn a_damaged_cache_entry_is_not_used() {
     // of its inputs, not on which stages ran) is reused; encode's knobs changed.
     assert_eq!(cached, ["voxelize", "form_factors", "reorder"]);
     assert_eq!(ran, ["load", "transport", "encode"]);
-    let fresh = tmp.path().join("fresh");
-    expect_code(
-        &bake(
-            tmp.path(),
-            &[
-                "-q",
-                "run",
-                b.to_str().unwrap(),
-                "--no-cache",
-                "--out",
-                fresh.to_str().unwrap(),
-            ],
-        ),
-        0,
-    );
-    same_bake(&out, &fresh);
+    same_bake(&out, &uncached_bake(tmp.path(), &b, "fresh"));
 }
 
 #[test]

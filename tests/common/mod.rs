@@ -14,6 +14,18 @@ pub fn data(rel: &str) -> PathBuf {
     repo().join(rel)
 }
 
+/// Start `relume-bake` with arguments in `cwd` and SIGKILL it after `seconds`.
+pub fn bake_killed_after(cwd: &Path, args: &[&str], seconds: f64) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_relume-bake"))
+        .args(args)
+        .current_dir(cwd)
+        .spawn()
+        .expect("relume-bake starts");
+    std::thread::sleep(std::time::Duration::from_secs_f64(seconds));
+    let _ = child.kill();
+    let _ = child.wait();
+}
+
 /// Run `relume-bake` with arguments in `cwd`.
 pub fn bake(cwd: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_relume-bake"))
