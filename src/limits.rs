@@ -121,8 +121,13 @@ pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
 /// The process's peak resident set so far (`VmHWM` of `/proc/self/status`), where the system
 /// reports it.
 pub fn peak_rss() -> Option<u64> {
+    status_bytes("VmHWM:")
+}
+
+/// A `kB` field of `/proc/self/status`, in bytes.
+fn status_bytes(field: &str) -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let line = status.lines().find(|l| l.starts_with(field))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib * 1024)
 }
@@ -142,10 +147,7 @@ pub fn tune_allocator() {
 
 /// The process's resident set now (`VmRSS`), where the system reports it.
 pub fn current_rss() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
+    status_bytes("VmRSS:")
 }
 
 /// Resident memory of the process that is not the work's buffers: `VmRSS` at the first call

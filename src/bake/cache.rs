@@ -210,10 +210,10 @@ fn clean_dead_temporaries(scope: &Path) {
         let Some(rest) = name.strip_prefix(".tmp-") else {
             continue;
         };
-        let pid = rest.split('-').next().unwrap_or("");
-        let tag = std::fs::read_to_string(e.path().join(baked::transaction::LOCK))
-            .unwrap_or_else(|_| pid.to_string());
-        if pid != std::process::id().to_string() && !baked::transaction::owner_alive(&tag) {
+        let Some(pid) = rest.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if baked::transaction::left_by_dead_process(&e.path(), pid) {
             let _ = std::fs::remove_dir_all(e.path());
         }
     }

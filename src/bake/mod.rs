@@ -191,7 +191,7 @@ pub fn run_pipeline(
     let files = txn.files();
     let all_cached = cache.is_some() && timings.iter().skip(1).all(|t| t.cached);
     manifest.files = files.clone();
-    let up_to_date = all_cached && holds(output, &manifest);
+    let up_to_date = all_cached && holds(output, &manifest, txn.staging_dir());
     if up_to_date {
         drop(txn);
     } else {
@@ -213,10 +213,37 @@ pub fn run_pipeline(
     })
 }
 
-/// Does the baked directory at `output` have exactly this manifest, with every file intact?
-fn holds(output: &Path, manifest: &Manifest) -> bool {
+/// Does the baked directory at `output` have exactly this manifest, with every file intact? A
+/// file of `output` that is the very file staged in `staged` (both hard links of one cache entry,
+/// whose hashes the lookup checked) is not hashed again: 0.51 s → 0.20 s for an up-to-date
+/// `cornell-4k` (257 MiB).
+fn holds(output: &Path, manifest: &Manifest, staged: &Path) -> bool {
     Manifest::read(output).is_ok_and(|m| m == *manifest)
-        && baked::manifest::verify(output, manifest).is_empty()
+        && baked::manifest::verify_files(
+            output,
+            manifest
+                .files
+                .iter()
+                .filter(|f| !same_file(&output.join(&f.name), &staged.join(&f.name))),
+        )
+        .is_empty()
+}
+
+/// Are `a` and `b` one file (the same inode of the same device)?
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (std::fs::metadata(a), std::fs::metadata(b)) {
+            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (a, b);
+        false
+    }
 }
 
 fn timing(record: &StageRecord, since: Instant, cached: bool) -> StageTiming {

@@ -155,8 +155,16 @@ pub struct VerifyProblem {
 /// Check every file the manifest lists: present, the recorded size, the recorded hash.
 /// Returns the list of problems (empty when the bake is intact).
 pub fn verify(dir: &Path, manifest: &Manifest) -> Vec<VerifyProblem> {
+    verify_files(dir, &manifest.files)
+}
+
+/// [`verify`] for some of a manifest's files.
+pub fn verify_files<'a>(
+    dir: &Path,
+    files: impl IntoIterator<Item = &'a FileRecord>,
+) -> Vec<VerifyProblem> {
     let mut problems = Vec::new();
-    for rec in &manifest.files {
+    for rec in files {
         let path = dir.join(&rec.name);
         let problem = match std::fs::metadata(&path) {
             Err(_) => Some("missing".to_string()),

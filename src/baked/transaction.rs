@@ -190,7 +190,7 @@ fn start_time(pid: u32) -> Option<String> {
 }
 
 /// Is the process that wrote `tag` (`PID START`) still running?
-pub(crate) fn owner_alive(tag: &str) -> bool {
+fn owner_alive(tag: &str) -> bool {
     let mut w = tag.split_whitespace();
     let Some(pid) = w.next().and_then(|p| p.parse::<u32>().ok()) else {
         return false;
@@ -203,6 +203,14 @@ pub(crate) fn owner_alive(tag: &str) -> bool {
         // SAFETY: signal 0 only checks that the process exists.
         (None, _) => (unsafe { libc::kill(pid as libc::pid_t, 0) }) == 0,
     }
+}
+
+/// Was the temporary directory `dir`, named after process `pid`, left by a process that no longer
+/// runs? Its `.relume-lock` names the writer (`PID START`); without one, the PID in the name does.
+/// Never true for this process.
+pub(crate) fn left_by_dead_process(dir: &Path, pid: u32) -> bool {
+    let tag = std::fs::read_to_string(dir.join(LOCK)).unwrap_or_else(|_| format!("{pid}"));
+    pid != std::process::id() && !owner_alive(&tag)
 }
 
 /// Remove what killed bakes of `target` left beside it: `.NAME.relume-tmp-PID` directories of
@@ -230,8 +238,7 @@ fn clean_stale(parent: &Path, name: &str, target: &Path) -> Result<()> {
             continue;
         };
         let path = e.path();
-        let tag = std::fs::read_to_string(path.join(LOCK)).unwrap_or_else(|_| format!("{pid}"));
-        if pid == std::process::id() || owner_alive(&tag) {
+        if !left_by_dead_process(&path, pid) {
             continue;
         }
         if is_old && !target.exists() {
