@@ -26,9 +26,33 @@ pub(super) fn grid_dims(extent: DVec3, size: f64) -> Option<[u32; 3]> {
     ])
 }
 
-/// Every visible polygon of the `live` triangles clipped into the voxels of a `dims` grid of
-/// voxel `size` (grid coordinates), keyed by (voxel, axis) group and sorted by (group, triangle),
-/// clipping order kept within a triangle.
+/// Clip every visible polygon of the `live` triangles into the voxels of a `dims` grid of voxel
+/// `size` (grid coordinates) and call `f(group key, index into live, piece, area)` for each
+/// piece that is not a sliver, in clipping order.
+pub(super) fn for_each_piece(
+    live: &[u32],
+    faces: &[Face],
+    polys: &[Vec<Polygon>],
+    size: f64,
+    dims: [u32; 3],
+    mut f: impl FnMut(u64, usize, Polygon, f64),
+) {
+    for k in 0..live.len() {
+        let axis = dominant_axis(faces[k].normal);
+        for poly in &polys[k] {
+            let grid: Polygon = poly.iter().map(|&p| p / size).collect();
+            for (voxel, piece) in clip_to_voxels(&grid, dims) {
+                let area = geometry::area(&piece);
+                if area > MIN_PIECE_AREA {
+                    f(group_key(voxel, axis, dims), k, piece, area);
+                }
+            }
+        }
+    }
+}
+
+/// The pieces of [`for_each_piece`], keyed by (voxel, axis) group and sorted by (group,
+/// triangle), clipping order kept within a triangle.
 pub(super) fn clip_pieces(
     live: &[u32],
     faces: &[Face],
@@ -37,26 +61,17 @@ pub(super) fn clip_pieces(
     dims: [u32; 3],
 ) -> Vec<(u64, Piece)> {
     let mut pieces: Vec<(u64, Piece)> = Vec::new();
-    for (k, &t) in live.iter().enumerate() {
-        let axis = dominant_axis(faces[k].normal);
-        for poly in &polys[k] {
-            let grid: Polygon = poly.iter().map(|&p| p / size).collect();
-            for (voxel, piece) in clip_to_voxels(&grid, dims) {
-                let area = geometry::area(&piece);
-                if area > MIN_PIECE_AREA {
-                    pieces.push((
-                        group_key(voxel, axis, dims),
-                        Piece {
-                            triangle: t,
-                            normal: faces[k].normal.to_array(),
-                            vertices: piece.iter().map(|p| p.to_array()).collect(),
-                            area,
-                        },
-                    ));
-                }
-            }
-        }
-    }
+    for_each_piece(live, faces, polys, size, dims, |key, k, piece, area| {
+        pieces.push((
+            key,
+            Piece {
+                triangle: live[k],
+                normal: faces[k].normal.to_array(),
+                vertices: piece.iter().map(|p| p.to_array()).collect(),
+                area,
+            },
+        ));
+    });
     pieces.sort_by_key(|(key, p)| (*key, p.triangle)); // stable: keeps clipping order
     pieces
 }

@@ -16,7 +16,7 @@
 //! split a scene into more than `n` clusters, and the count can jump between two sizes closer
 //! than the search resolves. [`SizeChoice::note`] then says which, for the stage to report.
 
-use super::clip::{clip_pieces, clusters, grid_dims};
+use super::clip::{clip_pieces, clusters, for_each_piece, grid_dims};
 use super::geometry::{self, Frame, Polygon};
 use super::overlap::Face;
 use super::visibility::Visibility;
@@ -57,10 +57,15 @@ impl SizeSearch<'_> {
         let Some(dims) = grid_dims(self.extent, size) else {
             return u64::MAX;
         };
-        let mut keys: Vec<u64> = clip_pieces(self.live, self.faces, self.polys, size, dims)
-            .into_iter()
-            .map(|(key, _)| key)
-            .collect();
+        let mut keys = Vec::new();
+        for_each_piece(
+            self.live,
+            self.faces,
+            self.polys,
+            size,
+            dims,
+            |key, _, _, _| keys.push(key),
+        );
         keys.sort_unstable();
         keys.dedup();
         keys.len() as u64
