@@ -9,6 +9,7 @@ pub mod bake;
 pub mod baked;
 pub mod compress;
 pub mod error;
+pub mod freeform;
 pub mod gpu;
 pub mod heightmap;
 pub mod limits;

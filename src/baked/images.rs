@@ -43,6 +43,19 @@ pub fn write_png_gray8(path: &Path, width: usize, height: usize, pixels: Vec<u8>
     })
 }
 
+/// Write an RGBA image as PNG, atomically.
+pub fn write_png_rgba(path: &Path, img: &image::RgbaImage) -> Result<()> {
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
+    write_atomic(path, |tmp| {
+        std::fs::write(tmp, &bytes).map_err(|e| Error::io(tmp, "cannot write", e))
+    })
+}
+
 /// Write a 16-bit grayscale PNG atomically.
 pub fn write_png_gray16(path: &Path, width: usize, height: usize, pixels: Vec<u16>) -> Result<()> {
     let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(

@@ -10,7 +10,7 @@ use crate::render::camera::Camera;
 use crate::render::mesh_reference::FrameSettings;
 use crate::scene::Light;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// What to render headless.
@@ -88,18 +88,7 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
     Ok(report)
 }
 
-/// Write an RGBA image as PNG, atomically.
-pub fn write_png(path: &Path, img: &image::RgbaImage) -> Result<()> {
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| Error::Internal(format!("PNG encoding failed: {e}")))?;
-    write_atomic(path, |tmp| {
-        std::fs::write(tmp, &bytes).map_err(|e| Error::io(tmp, "cannot write", e))
-    })
-}
+pub use crate::baked::images::write_png_rgba as write_png;
 
 /// Command-line values of the player, parsed and checked here so that the binary stays thin.
 pub mod args {

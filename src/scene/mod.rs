@@ -6,6 +6,7 @@
 //! multiplied by the pipeline's `scale` knob (the bundled Cornell box is in millimetres);
 //! front faces wind counter-clockwise; emission is radiance L (W·m⁻²·sr⁻¹, OBJ `Ke`).
 
+pub mod freeform;
 mod gltf_loader;
 mod obj_loader;
 pub mod punctual;

@@ -2,6 +2,7 @@
 //! library, show progress, print errors with their cause chain, exit with a code per cause.
 
 mod compress;
+mod freeform;
 mod radiosity;
 mod study;
 mod terrain;
@@ -105,6 +106,9 @@ enum Command {
     },
     #[command(flatten)]
     Compress(compress::CompressCommand),
+    /// Function-based geometry: render freeform scenes (quadrics + perturbations, CSG)
+    #[command(subcommand, after_help = EXIT_CODES)]
+    Freeform(freeform::FreeformCommand),
     /// Speed/accuracy sweeps: error vs time vs bytes for every knob (JSON, Markdown, PNG plots)
     #[command(after_help = EXIT_CODES)]
     Study(study::StudyArgs),
@@ -278,6 +282,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         }
         Command::Radiosity(c) => radiosity::run(c, json, cli.global.quiet, ui),
         Command::Compress(c) => compress::run(c, ui, json, cli.global.quiet),
+        Command::Freeform(c) => freeform::run(c, json, cli.global.quiet),
         Command::Study(a) => study::run(a, ui, json, cli.global.quiet),
         Command::Shadow(a) => terrain::shadow(a, ui, cli.global.quiet, json),
         Command::Softshadow(a) => terrain::softshadow(a, ui, cli.global.quiet, json),

@@ -4,6 +4,8 @@
 //! this version does not support, or relume itself (a bug). Every variant names the offending
 //! path when there is one; binaries print the whole cause chain and exit with [`Error::exit_code`].
 
+pub mod ron_located;
+
 use std::fmt;
 use std::path::{Path, PathBuf};
 
