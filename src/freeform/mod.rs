@@ -14,6 +14,7 @@
 
 pub mod bounds;
 pub mod field;
+pub mod mesh;
 pub mod poly;
 pub mod reference;
 pub mod rmlrc;

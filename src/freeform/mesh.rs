@@ -1,0 +1,1 @@
+//! Placeholder: polygonisation of a freeform field (being written).
