@@ -15,10 +15,13 @@
 pub mod bounds;
 pub mod field;
 pub mod mesh;
+pub mod mesh_error;
 pub mod poly;
 pub mod reference;
 pub mod rmlrc;
 pub mod shade;
+pub mod twin;
+pub mod twin_cast;
 pub mod view;
 
 pub use bounds::Bound;

@@ -8,6 +8,7 @@
 pub mod blit;
 pub mod compressed_gather;
 pub mod compute;
+pub mod freeform_caster;
 pub mod mesh_renderer;
 pub mod radiosity_runtime;
 pub mod readback;
@@ -177,6 +178,7 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "common.wgsl",
     "corner_interpolate.wgsl",
     "direct_light.wgsl",
+    "freeform.wgsl",
     "gather_compressed.wgsl",
     "gather_dense.wgsl",
     "lighting.wgsl",

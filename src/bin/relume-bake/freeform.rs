@@ -22,6 +22,31 @@ pub enum FreeformCommand {
     /// Ray cast a freeform scene to an image (and a depth map)
     #[command(after_help = SCENE_HELP)]
     Render(RenderArgs),
+    /// Polygonise a freeform scene to a triangle mesh (.obj) within a distance tolerance
+    #[command(after_help = SCENE_HELP)]
+    Mesh(MeshArgs),
+}
+
+#[derive(Args)]
+pub struct MeshArgs {
+    /// Freeform scene (.ron)
+    pub scene: PathBuf,
+    /// Largest distance from the mesh to the surface (scene units)
+    #[arg(long, value_name = "E")]
+    pub tolerance: f64,
+    /// Box to mesh, LO:HI, e.g. -2,-2,-2:2,2,2 (surfaces are cut at its faces)
+    #[arg(long, value_name = "LO:HI", value_parser = parse_box, allow_hyphen_values = true, default_value = "-2,-2,-2:2,2,2")]
+    pub bounds: ([f64; 3], [f64; 3]),
+    /// Mesh to write (.obj)
+    #[arg(long, value_name = "MESH.obj")]
+    pub out: PathBuf,
+}
+
+fn parse_box(s: &str) -> Result<([f64; 3], [f64; 3]), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or("expected LO:HI, e.g. -2,-2,-2:2,2,2")?;
+    Ok((triple(a)?, triple(b)?))
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -124,6 +149,7 @@ pub fn default_camera() -> FreeformCamera {
 pub fn run(cmd: &FreeformCommand, json: bool, quiet: bool) -> Result<i32> {
     match cmd {
         FreeformCommand::Render(a) => render(a, json, quiet),
+        FreeformCommand::Mesh(a) => mesh(a, json, quiet),
     }
 }
 
@@ -209,6 +235,44 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
             } else {
                 String::new()
             }
+        );
+    }
+    Ok(exit::OK)
+}
+
+fn mesh(a: &MeshArgs, json: bool, quiet: bool) -> Result<i32> {
+    use relume::freeform::mesh::{self, MeshParams};
+    check_extension(&a.out, &["obj"])?;
+    let scene = FreeformScene::load(&a.scene)?;
+    let field = Field::compile(&scene.shape).map_err(|e| Error::input(&a.scene, e))?;
+    let params = MeshParams {
+        lo: a.bounds.0,
+        hi: a.bounds.1,
+        tolerance: a.tolerance,
+    };
+    let t0 = Instant::now();
+    let (m, stats) = mesh::polygonise_with_stats(&field, &params)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    images::write_atomic(&a.out, |tmp| {
+        let mut f = std::fs::File::create(tmp).map_err(|e| Error::io(tmp, "cannot create", e))?;
+        mesh::write_obj(&m, &mut f).map_err(|e| Error::io(tmp, "cannot write", e))
+    })?;
+    let obj = mesh::obj_bytes(&m);
+    let ron = std::fs::metadata(&a.scene).map(|m| m.len()).unwrap_or(0);
+    if json {
+        let j = json!({
+            "scene": a.scene.display().to_string(), "out": a.out.display().to_string(),
+            "tolerance": a.tolerance, "triangles": m.triangles.len(), "vertices": m.positions.len(),
+            "obj_bytes": obj, "scene_bytes": ron, "seconds": seconds,
+            "spacing": stats.spacing, "crease": stats.crease, "grid": stats.grid,
+        });
+        println!("{}", serde_json::to_string_pretty(&j).expect("json"));
+    } else if !quiet {
+        eprintln!(
+            "meshed {} ({} triangles, {} bytes of OBJ against {ron} bytes of scene) in {seconds:.2} s",
+            a.out.display(),
+            m.triangles.len(),
+            obj
         );
     }
     Ok(exit::OK)
