@@ -191,8 +191,8 @@ pub fn quad_affine(q: &Quad, cell: &Cell) -> Affine {
         let mjj = dot(cell.v[j], av[j]);
         out.x0 += 0.5 * mjj;
         out.e += 0.5 * mjj.abs();
-        for k in j + 1..SYMBOLS {
-            out.e += 2.0 * dot(cell.v[j], av[k]).abs();
+        for avk in &av[j + 1..] {
+            out.e += 2.0 * dot(cell.v[j], *avk).abs();
         }
     }
     out

@@ -103,6 +103,7 @@ pub fn camera_outside(field: &Field, view: &View, bound: Bound) -> bool {
 }
 
 /// Walk one tile's range at cell size `ds` and return its new range.
+#[allow(clippy::too_many_arguments)]
 fn tile_pass(
     field: &Field,
     view: &View,
@@ -149,6 +150,7 @@ fn tile_pass(
 
 /// Depth-first search of a line's range `[s0, s1]` (log of the line parameter) for the first
 /// surface point. `cell_of(s0, s1)` builds the cell; `point(t)` is the line at parameter t.
+#[allow(clippy::too_many_arguments)]
 pub fn line_search(
     field: &Field,
     bound: Bound,

@@ -251,7 +251,8 @@ fn mat_vec(a: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
     [dot3(a[0], v), dot3(a[1], v), dot3(a[2], v)]
 }
 
-/// A quadric over an f32 cell, widened.
+/// A quadric over an f32 cell, widened. (Indexed loops: they mirror the kernel's.)
+#[allow(clippy::needless_range_loop)]
 pub fn quad_aff32(q: &GpuQuad, cell: &Cell32) -> Aff32 {
     let (a, b, c0) = unpack(q);
     let ac = mat_vec(&a, cell.c);

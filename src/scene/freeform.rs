@@ -78,7 +78,7 @@ pub struct SunAngles {
 /// A node of the CSG tree.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Shape {
-    Surface(Surface),
+    Surface(Box<Surface>),
     /// Points inside any child (`min` of the fields).
     Union(Vec<Shape>),
     /// Points inside every child (`max`).
