@@ -61,7 +61,9 @@ fn words(shader: &'static str, wgsl: &'static str, names: &[&'static str]) -> Sh
 }
 
 fn shared_structs() -> Vec<Shared> {
+    use relume::freeform::twin::{GpuBump, GpuLeaf};
     use relume::gpu::compressed_gather::Params as GatherParams;
+    use relume::gpu::freeform_caster::FrameU as FreeformFrame;
     use relume::gpu::mesh_renderer::FrameUniform;
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
     vec![
@@ -98,6 +100,24 @@ fn shared_structs() -> Vec<Shared> {
             "_pad": field!(GatherParams, pad),
             "scale": field!(GatherParams, scale),
             "lut": field!(GatherParams, lut),
+        }),
+        shared!("freeform.wgsl", "Frame", FreeformFrame {
+            "forward": field!(FreeformFrame, forward),
+            "right": field!(FreeformFrame, right),
+            "up": field!(FreeformFrame, up),
+            "depth": field!(FreeformFrame, depth),
+            "size": field!(FreeformFrame, size),
+            "level": field!(FreeformFrame, level),
+        }),
+        shared!("freeform.wgsl", "Leaf", GpuLeaf {
+            "base": field!(GpuLeaf, base),
+            "range": field!(GpuLeaf, range),
+            "material": field!(GpuLeaf, material),
+        }),
+        shared!("freeform.wgsl", "Bump", GpuBump {
+            "q": field!(GpuBump, q),
+            "lo_weight": field!(GpuBump, lo_weight),
+            "hi_flag": field!(GpuBump, hi_flag),
         }),
         shared!("terrain_render.wgsl", "TerrainFrame", TerrainFrame {
             "view_proj": field!(TerrainFrame, view_proj),

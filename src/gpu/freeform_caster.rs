@@ -8,15 +8,16 @@ use super::Gpu;
 use crate::error::Result;
 use crate::freeform::twin::{GpuField, View32};
 
+/// The kernel's `Frame` uniform (one per level).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct FrameU {
-    forward: [f32; 4],
-    right: [f32; 4],
-    up: [f32; 4],
-    depth: [f32; 4],
-    size: [u32; 4],
-    level: [u32; 4],
+pub struct FrameU {
+    pub forward: [f32; 4],
+    pub right: [f32; 4],
+    pub up: [f32; 4],
+    pub depth: [f32; 4],
+    pub size: [u32; 4],
+    pub level: [u32; 4],
 }
 
 /// Compiled kernels of the freeform caster.

@@ -1,0 +1,87 @@
+//! Frame times of the freeform casters — the table the seed lost: a plane with 16, 64 and 256
+//! perturbations (`scenes/freeform/bench/terrain-N.ron`) at 640x480 (and, with `--all`, 1280x720
+//! and 1920x1080), by the exact CPU reference, the CPU multilevel caster (affine bound) and the
+//! GPU kernel (`shaders/freeform.wgsl`). Primary rays only (no shading, no shadows), as ratios
+//! against the reference in the same run. On Mesa's lavapipe the "GPU" time is a software
+//! rasteriser's CPU time.
+//!
+//! `cargo bench --bench freeform_frames [-- --all]`
+
+use relume::freeform::rmlrc::{camera_outside, cast, RmlrcParams};
+use relume::freeform::shade::primary;
+use relume::freeform::twin::{GpuField, View32};
+use relume::freeform::{Bound, Field, Method, View};
+use relume::gpu::freeform_caster::FreeformCaster;
+use relume::gpu::Gpu;
+use relume::scene::freeform::FreeformScene;
+use std::path::Path;
+use std::time::Instant;
+
+fn seconds(f: impl FnOnce()) -> f64 {
+    let t = Instant::now();
+    f();
+    t.elapsed().as_secs_f64()
+}
+
+fn main() {
+    let all = std::env::args().any(|a| a == "--all");
+    let sizes: &[(u32, u32)] = if all {
+        &[(640, 480), (1280, 720), (1920, 1080)]
+    } else {
+        &[(640, 480)]
+    };
+    let gpu = Gpu::new(None).ok();
+    let caster = gpu
+        .as_ref()
+        .map(|g| FreeformCaster::new(g).expect("kernel compiles"));
+    let adapter = gpu
+        .as_ref()
+        .map(|g| g.info.name.clone())
+        .unwrap_or_else(|| "none".into());
+    println!("GPU adapter: {adapter}\n");
+    println!(
+        "| perturbations | size | reference s | RMLRC CPU s (÷ ref) | GPU s (÷ ref) | hit pixels |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for n in [16, 64, 256] {
+        let scene =
+            FreeformScene::load(&root.join(format!("scenes/freeform/bench/terrain-{n}.ron")))
+                .unwrap();
+        let field = Field::compile(&scene.shape).unwrap();
+        for &(w, h) in sizes {
+            let view = View::new(scene.camera.as_ref().unwrap(), w, h);
+            let params = RmlrcParams::default();
+            let mut hits = 0;
+            let reference = seconds(|| {
+                hits = primary(&field, &view, &Method::Reference)
+                    .0
+                    .iter()
+                    .filter(|h| h.is_some())
+                    .count();
+            });
+            let rmlrc = seconds(|| {
+                cast(&field, &view, &params);
+            });
+            let gpu_s = match (&gpu, &caster) {
+                (Some(g), Some(c)) => {
+                    let gf = GpuField::upload(&field, view.eye).unwrap();
+                    let v32 = View32::of(&view);
+                    let prune = camera_outside(&field, &view, Bound::Affine);
+                    c.cast(g, &gf, &v32, params.top_level, params.refine, prune)
+                        .unwrap(); // warm-up
+                    let s = seconds(|| {
+                        c.cast(g, &gf, &v32, params.top_level, params.refine, prune)
+                            .unwrap();
+                    });
+                    format!("{s:.3} ({:.2})", s / reference)
+                }
+                _ => "no adapter".into(),
+            };
+            println!(
+                "| {n} | {w}x{h} | {reference:.3} | {rmlrc:.3} ({:.2}) | {gpu_s} | {hits} |",
+                rmlrc / reference
+            );
+        }
+    }
+}
