@@ -40,7 +40,7 @@ fn main() {
         .unwrap_or_else(|| "none".into());
     println!("GPU adapter: {adapter}\n");
     println!(
-        "| perturbations | size | reference s | RMLRC CPU s (÷ ref) | GPU s (÷ ref) | hit pixels |"
+        "| perturbations | size | reference s | RMLRC CPU s (÷ ref) | GPU s (÷ ref), GPU hits | reference hits |"
     );
     println!("|---|---|---|---|---|---|");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -70,11 +70,14 @@ fn main() {
                     let prune = camera_outside(&field, &view, Bound::Affine);
                     c.cast(g, &gf, &v32, params.top_level, params.refine, prune)
                         .unwrap(); // warm-up
+                    let mut gpu_hits = 0;
                     let s = seconds(|| {
-                        c.cast(g, &gf, &v32, params.top_level, params.refine, prune)
+                        let out = c
+                            .cast(g, &gf, &v32, params.top_level, params.refine, prune)
                             .unwrap();
+                        gpu_hits = out.iter().filter(|h| h[0] >= 0.0).count();
                     });
-                    format!("{s:.3} ({:.2})", s / reference)
+                    format!("{s:.3} ({:.2}), {gpu_hits} hits", s / reference)
                 }
                 _ => "no adapter".into(),
             };
