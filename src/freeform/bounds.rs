@@ -228,7 +228,7 @@ fn bump_skipped(b: &Bump, lo: [f64; 3], hi: [f64; 3]) -> bool {
     }
 }
 
-/// Work done by one bound evaluation: leaves evaluated, perturbation terms evaluated.
+/// Work done by bound evaluations: quadric terms evaluated (bases and perturbations).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Work {
     pub terms: u64,

@@ -19,7 +19,7 @@
 //! Each level is one parallel pass over its tiles (the GPU runs one compute pass per level);
 //! results are independent of the thread count.
 
-use super::bounds::{field_range, Bound, Cell, Work};
+use super::bounds::{field_range, Bound, Work};
 use super::field::Field;
 use super::view::{line_cell, View};
 use rayon::prelude::*;
@@ -371,11 +371,4 @@ pub fn occluded(
         &mut c,
     )
     .is_some()
-}
-
-/// The cell of a pixel-level segment, exposed for the GPU twin's tests.
-pub fn pixel_cell(view: &View, px: u32, py: u32, s: [f64; 2]) -> Cell {
-    let x = view.screen_x(px as f64 + 0.5);
-    let y = view.screen_y(py as f64 + 0.5);
-    view.cell([x, x], [y, y], s)
 }

@@ -1,7 +1,6 @@
 //! From hits to a frame: normal from the field's gradient, Lambert and Phong with the sun, sun
 //! shadows by casting toward the sun through the same field (by the frame's own method).
 
-use super::bounds::Bound;
 use super::field::{dot, Field};
 use super::reference;
 use super::rmlrc::{self, CastStats, RmlrcParams};
@@ -140,6 +139,3 @@ fn in_shadow(
         }
     }
 }
-
-/// The default bound of the multilevel caster.
-pub const DEFAULT_BOUND: Bound = Bound::Affine;
