@@ -12,7 +12,7 @@ struct Frame {
     forward: vec4<f32>,   // xyz, tan_x
     right: vec4<f32>,     // xyz, tan_y
     up: vec4<f32>,        // xyz, theta (one pixel's angle)
-    depth: vec4<f32>,     // near_ln, far_ln, min_cell, unused
+    depth: vec4<f32>,     // near_ln, far_ln, min_cell, depth cells per tile pass
     size: vec4<u32>,      // width, height, ops, prune
     level: vec4<u32>,     // tile size, cols, parent_cols, is_top
 }
@@ -21,21 +21,34 @@ struct Frame {
 @group(0) @binding(1) var<storage, read> leaves: array<Leaf>;
 @group(0) @binding(2) var<storage, read> bumps: array<Bump>;
 @group(0) @binding(3) var<storage, read> ops: array<u32>;
-@group(0) @binding(4) var<storage, read> parent_ranges: array<vec2<f32>>;
-@group(0) @binding(5) var<storage, read_write> out_ranges: array<vec2<f32>>;
+// Per tile: (log-depth lo, hi, next depth cell, state: 0 new, 1 walking, 2 done).
+@group(0) @binding(4) var<storage, read> parent_ranges: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> out_ranges: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> hits: array<vec4<f32>>;
+// The pixel pass only: each pixel's place in its search (node depth, node index, candidate,
+// limit) between rounds, and per round the number of pixels that did not finish in it.
+@group(0) @binding(7) var<storage, read_write> search: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read_write> unfinished: array<atomic<u32>>;
 
-const SYM: u32 = 8u;
 const MAX_STACK: u32 = 8u;
-const MAX_DFS: u32 = 48u;
+const MAX_DEPTH: u32 = 24u;
+const REFINE_STEPS: i32 = 24;
 const KC: f32 = 9.5367431640625e-7;
 const KQ: f32 = 1.52587890625e-5;
 const KR: f32 = 9.5367431640625e-7;
 const TINY: f32 = 1e-30;
 const INF: f32 = 3.0e38;
 
-struct Aff { x0: f32, g: array<f32, 8>, e: f32 }
-struct Cell { c: vec3<f32>, v: array<vec3<f32>, 8> }
+// The eight noise symbols are held as pairs of vec4s, and nothing loops over them: Mesa's
+// lavapipe stops every loop of an invocation after 65,535 back-edges in all (gallivm's
+// LP_MAX_TGSI_LOOP_ITERATIONS), so the only loops left are over perturbations, depth cells and
+// subdivision steps, and the host splits those into passes (see `tile`).
+struct Aff { x0: f32, e: f32, g0: vec4<f32>, g1: vec4<f32> }
+// A cell: centre and the x, y, z components of the eight generators (0..3 in *0, 4..7 in *1).
+struct Cell { c: vec3<f32>, x0: vec4<f32>, x1: vec4<f32>, y0: vec4<f32>, y1: vec4<f32>, z0: vec4<f32>, z1: vec4<f32> }
+
+fn sum4(v: vec4<f32>) -> f32 { return (v.x + v.y) + (v.z + v.w); }
+fn sum8_abs(a: vec4<f32>, b: vec4<f32>) -> f32 { return sum4(abs(a)) + sum4(abs(b)); }
 
 fn exp32(x: f32) -> f32 {
     let y = x * 1.442695040888963;
@@ -46,46 +59,40 @@ fn exp32(x: f32) -> f32 {
 }
 
 fn make_cell(c: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, v3: vec3<f32>, v4: vec3<f32>) -> Cell {
+    let r = abs(c) + abs(v0) + abs(v1) + abs(v2) + abs(v3) + abs(v4);
+    let k = KC * r + TINY;
     var cell: Cell;
     cell.c = c;
-    cell.v[0] = v0; cell.v[1] = v1; cell.v[2] = v2; cell.v[3] = v3; cell.v[4] = v4;
-    let r = abs(c) + abs(v0) + abs(v1) + abs(v2) + abs(v3) + abs(v4);
-    cell.v[5] = vec3<f32>(KC * r.x + TINY, 0.0, 0.0);
-    cell.v[6] = vec3<f32>(0.0, KC * r.y + TINY, 0.0);
-    cell.v[7] = vec3<f32>(0.0, 0.0, KC * r.z + TINY);
+    cell.x0 = vec4<f32>(v0.x, v1.x, v2.x, v3.x);
+    cell.y0 = vec4<f32>(v0.y, v1.y, v2.y, v3.y);
+    cell.z0 = vec4<f32>(v0.z, v1.z, v2.z, v3.z);
+    cell.x1 = vec4<f32>(v4.x, k.x, 0.0, 0.0);
+    cell.y1 = vec4<f32>(v4.y, 0.0, k.y, 0.0);
+    cell.z1 = vec4<f32>(v4.z, 0.0, 0.0, k.z);
     return cell;
 }
 
 fn extent(cell: Cell) -> vec3<f32> {
-    var e = vec3<f32>(0.0);
-    for (var k = 0u; k < SYM; k++) { e += abs(cell.v[k]); }
-    return e;
+    return vec3<f32>(sum8_abs(cell.x0, cell.x1), sum8_abs(cell.y0, cell.y1), sum8_abs(cell.z0, cell.z1));
 }
 
 fn aff_range(a: Aff) -> vec2<f32> {
-    var r = a.e;
-    for (var k = 0u; k < SYM; k++) { r += abs(a.g[k]); }
+    var r = a.e + sum8_abs(a.g0, a.g1);
     r = r + KR * (r + abs(a.x0)) + TINY;
     return vec2<f32>(a.x0 - r, a.x0 + r);
 }
 
 fn aff_widen(a: ptr<function, Aff>) {
-    var m = abs((*a).x0) + (*a).e;
-    for (var k = 0u; k < SYM; k++) { m += abs((*a).g[k]); }
+    let m = (abs((*a).x0) + (*a).e) + sum8_abs((*a).g0, (*a).g1);
     (*a).e += KR * m + TINY;
 }
 
 fn aff_const(x: f32) -> Aff {
-    var a: Aff;
-    a.x0 = x;
-    a.e = 0.0;
-    for (var k = 0u; k < SYM; k++) { a.g[k] = 0.0; }
-    return a;
+    return Aff(x, 0.0, vec4<f32>(0.0), vec4<f32>(0.0));
 }
 
 fn aff_hull(lo: f32, hi: f32) -> Aff {
-    var a = aff_const(0.5 * (lo + hi));
-    a.e = 0.5 * (hi - lo);
+    var a = Aff(0.5 * (lo + hi), 0.5 * (hi - lo), vec4<f32>(0.0), vec4<f32>(0.0));
     aff_widen(&a);
     return a;
 }
@@ -106,34 +113,47 @@ fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
+// Σ_k |vx·ax[k] + vy·ay[k] + vz·az[k]|: one row of the cell's generator Gram matrix under A.
+fn row_abs(vx: f32, vy: f32, vz: f32, ax0: vec4<f32>, ax1: vec4<f32>, ay0: vec4<f32>, ay1: vec4<f32>, az0: vec4<f32>, az1: vec4<f32>) -> f32 {
+    return sum8_abs(vx * ax0 + vy * ay0 + vz * az0, vx * ax1 + vy * ay1 + vz * az1);
+}
+
 fn quad_aff(q: Quad, cell: Cell) -> Aff {
     let a = quad_a(q);
     let b = vec3<f32>(q.r1.z, q.r1.w, q.r2.x);
     let c0 = q.r2.y;
     let ac = mat_vec(a, cell.c);
     let gc = ac + b;
-    var out = aff_const(dot3(ac, cell.c) + 2.0 * dot3(b, cell.c) + c0);
-    var av: array<vec3<f32>, 8>;
-    for (var k = 0u; k < SYM; k++) {
-        out.g[k] = 2.0 * dot3(gc, cell.v[k]);
-        av[k] = mat_vec(a, cell.v[k]);
-    }
-    for (var j = 0u; j < SYM; j++) {
-        let mjj = dot3(cell.v[j], av[j]);
-        out.x0 += 0.5 * mjj;
-        out.e += 0.5 * abs(mjj);
-        for (var k = j + 1u; k < SYM; k++) {
-            out.e += 2.0 * abs(dot3(cell.v[j], av[k]));
-        }
-    }
+    var out: Aff;
+    out.g0 = 2.0 * (gc.x * cell.x0 + gc.y * cell.y0 + gc.z * cell.z0);
+    out.g1 = 2.0 * (gc.x * cell.x1 + gc.y * cell.y1 + gc.z * cell.z1);
+    // A·v_k for the eight generators, by component.
+    let ax0 = a[0].x * cell.x0 + a[0].y * cell.y0 + a[0].z * cell.z0;
+    let ax1 = a[0].x * cell.x1 + a[0].y * cell.y1 + a[0].z * cell.z1;
+    let ay0 = a[1].x * cell.x0 + a[1].y * cell.y0 + a[1].z * cell.z0;
+    let ay1 = a[1].x * cell.x1 + a[1].y * cell.y1 + a[1].z * cell.z1;
+    let az0 = a[2].x * cell.x0 + a[2].y * cell.y0 + a[2].z * cell.z0;
+    let az1 = a[2].x * cell.x1 + a[2].y * cell.y1 + a[2].z * cell.z1;
+    let d0 = cell.x0 * ax0 + cell.y0 * ay0 + cell.z0 * az0;
+    let d1 = cell.x1 * ax1 + cell.y1 * ay1 + cell.z1 * az1;
+    out.x0 = (dot3(ac, cell.c) + 2.0 * dot3(b, cell.c) + c0) + 0.5 * (sum4(d0) + sum4(d1));
+    var total = row_abs(cell.x0.x, cell.y0.x, cell.z0.x, ax0, ax1, ay0, ay1, az0, az1);
+    total += row_abs(cell.x0.y, cell.y0.y, cell.z0.y, ax0, ax1, ay0, ay1, az0, az1);
+    total += row_abs(cell.x0.z, cell.y0.z, cell.z0.z, ax0, ax1, ay0, ay1, az0, az1);
+    total += row_abs(cell.x0.w, cell.y0.w, cell.z0.w, ax0, ax1, ay0, ay1, az0, az1);
+    total += row_abs(cell.x1.x, cell.y1.x, cell.z1.x, ax0, ax1, ay0, ay1, az0, az1);
+    total += row_abs(cell.x1.y, cell.y1.y, cell.z1.y, ax0, ax1, ay0, ay1, az0, az1);
+    total += row_abs(cell.x1.z, cell.y1.z, cell.z1.z, ax0, ax1, ay0, ay1, az0, az1);
+    total += row_abs(cell.x1.w, cell.y1.w, cell.z1.w, ax0, ax1, ay0, ay1, az0, az1);
+    // ½Σ|M_jj| + 2Σ_{j<k}|M_jk| = Σ_jk|M_jk| − ½Σ|M_jj|.
+    out.e = total - 0.5 * sum8_abs(d0, d1);
     let x = abs(cell.c) + extent(cell);
-    var m = abs(c0);
-    for (var i = 0u; i < 3u; i++) {
-        m += 2.0 * abs(b[i]) * x[i];
-        for (var j = 0u; j < 3u; j++) {
-            m += abs(a[i][j]) * x[i] * x[j];
-        }
-    }
+    let ab = abs(b);
+    let ax = vec3<f32>(
+        abs(a[0].x) * x.x + abs(a[0].y) * x.y + abs(a[0].z) * x.z,
+        abs(a[1].x) * x.x + abs(a[1].y) * x.y + abs(a[1].z) * x.z,
+        abs(a[2].x) * x.x + abs(a[2].y) * x.y + abs(a[2].z) * x.z);
+    let m = abs(c0) + 2.0 * (ab.x * x.x + ab.y * x.y + ab.z * x.z) + (x.x * ax.x + x.y * ax.y + x.z * ax.z);
     out.e += KQ * m + TINY;
     return out;
 }
@@ -157,7 +177,8 @@ fn relu_cube(x: Aff) -> Aff {
     let delta = max(max(abs(cube0(lo) - (alpha * lo + zeta)), abs(cube0(hi) - (alpha * hi + zeta))), abs(cube0(u) - (alpha * u + zeta)));
     var out: Aff;
     out.x0 = alpha * x.x0 + zeta;
-    for (var k = 0u; k < SYM; k++) { out.g[k] = alpha * x.g[k]; }
+    out.g0 = alpha * x.g0;
+    out.g1 = alpha * x.g1;
     out.e = alpha * x.e + delta + KR * (fhi + alpha * max(abs(lo), abs(hi)) + abs(zeta));
     aff_widen(&out);
     return out;
@@ -184,7 +205,8 @@ fn field_range(cell: Cell) -> vec2<f32> {
                     let c = relu_cube(q);
                     let w = b.lo_weight.w;
                     r.x0 += w * c.x0;
-                    for (var k = 0u; k < SYM; k++) { r.g[k] += w * c.g[k]; }
+                    r.g0 += w * c.g0;
+                    r.g1 += w * c.g1;
                     r.e += abs(w) * c.e;
                     aff_widen(&r);
                 }
@@ -192,7 +214,8 @@ fn field_range(cell: Cell) -> vec2<f32> {
             stack[slot] = r;
         } else if (kind == 3u) {
             stack[slot].x0 = -stack[slot].x0;
-            for (var k = 0u; k < SYM; k++) { stack[slot].g[k] = -stack[slot].g[k]; }
+            stack[slot].g0 = -stack[slot].g0;
+            stack[slot].g1 = -stack[slot].g1;
         } else {
             // A binary min or max of the two top values.
             let x = stack[slot];
@@ -230,6 +253,11 @@ fn pyramid_cell(x0: f32, x1: f32, y0: f32, y1: f32, s0: f32, s1: f32) -> Cell {
     return make_cell(dc * zc, dc * zr, r * (zc * xr), u * (zc * yr), r * (zr * xr), u * (zr * yr));
 }
 
+// One pass over one level: each tile walks at most `frame.depth.w` depth cells of its parent's
+// range and keeps its place in `out_ranges`; the host records as many passes as the longest
+// possible walk needs, so every tile is done before the next level reads it. (Lavapipe ends an
+// invocation's loops after 65,535 back-edges; a pass stays below that. On a GPU, short passes
+// also keep a frame clear of the driver's watchdog.)
 @compute @workgroup_size(8, 8)
 fn tile(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = frame.level.x;
@@ -238,38 +266,54 @@ fn tile(@builtin(global_invocation_id) id: vec3<u32>) {
     let h = frame.size.y;
     let rows = (h + size - 1u) / size;
     if (id.x >= cols || id.y >= rows) { return; }
+    let idx = id.y * cols + id.x;
+    let state = out_ranges[idx];
+    if (state.w == 2.0) { return; }
     var parent: vec2<f32>;
     if (frame.level.w == 1u) {
-        parent = parent_ranges[0];
+        parent = parent_ranges[0].xy;
     } else {
-        parent = parent_ranges[(id.y / 2u) * frame.level.z + id.x / 2u];
+        parent = parent_ranges[(id.y / 2u) * frame.level.z + id.x / 2u].xy;
     }
+    if (parent.x > parent.y) {
+        out_ranges[idx] = vec4<f32>(INF, -INF, 0.0, 2.0);
+        return;
+    }
+    let ds = frame.up.w * f32(size);
+    let near_ln = frame.depth.x;
+    let x0 = screen_x(f32(id.x * size));
+    let x1 = screen_x(f32(min((id.x + 1u) * size, w)));
+    let y0 = screen_y(f32(min((id.y + 1u) * size, h)));
+    let y1 = screen_y(f32(id.y * size));
+    let first = i32(floor((parent.x - near_ln) / ds));
+    let end = max(i32(ceil((parent.y - near_ln) / ds)), first + 1);
     var out = vec2<f32>(INF, -INF);
-    if (parent.x <= parent.y) {
-        let ds = frame.up.w * f32(size);
-        let near_ln = frame.depth.x;
-        let x0 = screen_x(f32(id.x * size));
-        let x1 = screen_x(f32(min((id.x + 1u) * size, w)));
-        let y0 = screen_y(f32(min((id.y + 1u) * size, h)));
-        let y1 = screen_y(f32(id.y * size));
-        let first = i32(floor((parent.x - near_ln) / ds));
-        let last = i32(ceil((parent.y - near_ln) / ds));
-        for (var k = first; k < max(last, first + 1); k++) {
-            let s0 = max(near_ln + f32(k) * ds, parent.x);
-            let s1 = min(near_ln + f32(k + 1) * ds, parent.y);
-            if (s1 <= s0) { continue; }
-            let r = field_range(pyramid_cell(x0, x1, y0, y1, s0, s1));
-            if (r.x <= 0.0 && r.y >= 0.0) {
-                if (out.x == INF) { out.x = s0; }
-                out.y = s1;
-            }
-            if (frame.size.w == 1u && r.y < 0.0) {
-                if (out.x != INF) { out.y = s1; }
-                break;
-            }
+    var k = first;
+    if (state.w == 1.0) {
+        out = state.xy;
+        k = i32(state.z);
+    }
+    let stop = min(end, k + i32(frame.depth.w));
+    var done = false;
+    for (; k < stop; k++) {
+        let s0 = max(near_ln + f32(k) * ds, parent.x);
+        let s1 = min(near_ln + f32(k + 1) * ds, parent.y);
+        if (s1 <= s0) { continue; }
+        let r = field_range(pyramid_cell(x0, x1, y0, y1, s0, s1));
+        if (r.x <= 0.0 && r.y >= 0.0) {
+            if (out.x == INF) { out.x = s0; }
+            out.y = s1;
+        }
+        if (frame.size.w == 1u && r.y < 0.0) {
+            if (out.x != INF) { out.y = s1; }
+            done = true;
+            break;
         }
     }
-    out_ranges[id.y * cols + id.x] = out;
+    if (k >= end) { done = true; }
+    var st = 1.0;
+    if (done) { st = 2.0; }
+    out_ranges[idx] = vec4<f32>(out, f32(k), st);
     // Never true: keeps `hits` in this entry's automatic layout (both entries share one).
     if (frame.size.x == 0u) { hits[0] = vec4<f32>(0.0); }
 }
@@ -345,87 +389,123 @@ fn normal_at(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(0.0, 1.0, 0.0);
 }
 
-// Depth-first log-depth search along o + t·d; returns t, or -1 when nothing is found.
-fn line_search(o: vec3<f32>, d: vec3<f32>, range: vec2<f32>, min_cell: f32, any_solid: bool) -> f32 {
-    var stack: array<vec2<f32>, 48>;
-    var sp = 1u;
-    stack[0] = range;
+// A node of the search's binary subdivision of `range`: depth d, index i (exact in f32 below
+// 2^24), bounds range.x + L·i·2^-d and range.x + L·(i+1)·2^-d.
+fn node_bounds(range: vec2<f32>, d: u32, i: u32) -> vec2<f32> {
+    let len = range.y - range.x;
+    let scale = ldexp(1.0, -i32(d));
+    return vec2<f32>(range.x + len * (f32(i) * scale), range.x + len * (f32(i + 1u) * scale));
+}
+
+struct Search { d: u32, i: u32, candidate: f32, limit: f32, done: bool, t: f32 }
+
+// Up to `steps` steps of the depth-first log-depth search along o + t·d, resuming `st`: a step
+// bounds one node and either culls it, splits it, or tests its end points. The search is
+// stackless (the next node follows from (d, i) alone), so a pixel can stop after any step and
+// go on in the next round. A sign change is refined in the same invocation after the search
+// loop (inside it, the refinement would run once per SIMD lane that reaches it, and lavapipe
+// counts every one against its loop limit). Result in st.t: t, or -1 when nothing is found.
+fn line_search(o: vec3<f32>, dir: vec3<f32>, range: vec2<f32>, min_cell: f32, any_solid: bool, st_in: Search, steps: u32) -> Search {
+    var st = st_in;
     let pixel_cells = min((range.y - range.x) / min_cell, 64.0);
-    var candidate = -1.0;
-    var limit = INF;
-    loop {
-        if (sp == 0u) { break; }
-        sp -= 1u;
-        let s = stack[sp];
-        if (candidate >= 0.0 && s.x >= limit) { break; }
+    var found = false;
+    var a = 0.0;
+    var b = 0.0;
+    var fa = 0.0;
+    var fb = 0.0;
+    for (var n = 0u; n < steps; n++) {
+        let s = node_bounds(range, st.d, st.i);
+        if (st.candidate >= 0.0 && s.x >= st.limit) { st.done = true; break; }
         let t0 = exp32(s.x);
         let t1 = exp32(s.y);
         let tc = 0.5 * (t0 + t1);
         let tr = 0.5 * (t1 - t0);
         let zero = vec3<f32>(0.0);
-        let r = field_range(make_cell(o + tc * d, d * tr, zero, zero, zero, zero));
+        let r = field_range(make_cell(o + tc * dir, dir * tr, zero, zero, zero, zero));
+        var next = true;
         if (!(r.x <= 0.0 && r.y >= 0.0)) {
-            if (any_solid && r.y < 0.0) { return tc; }
-            continue;
-        }
-        if (s.y - s.x > min_cell && sp + 2u <= MAX_DFS) {
-            let m = 0.5 * (s.x + s.y);
-            stack[sp] = vec2<f32>(m, s.y);
-            stack[sp + 1u] = vec2<f32>(s.x, m);
-            sp += 2u;
-            continue;
-        }
-        var a = t0;
-        var b = t1;
-        var fa = eval_point(o + a * d).x;
-        var fb = eval_point(o + b * d).x;
-        if ((fa <= 0.0) != (fb <= 0.0)) {
-            var side = 0;
-            for (var it = 0; it < 24; it++) {
-                var c = (a * fb - b * fa) / (fb - fa);
-                if (!(c > a && c < b)) { c = 0.5 * (a + b); }
-                let fc = eval_point(o + c * d).x;
-                if ((fc < 0.0) == (fa < 0.0)) {
-                    a = c; fa = fc;
-                    if (side == -1) { fb *= 0.5; }
-                    side = -1;
-                } else {
-                    b = c; fb = fc;
-                    if (side == 1) { fa *= 0.5; }
-                    side = 1;
-                }
+            if (any_solid && r.y < 0.0) { st.t = tc; st.done = true; return st; }
+        } else if (s.y - s.x > min_cell && st.d < MAX_DEPTH) {
+            st.d += 1u;
+            st.i *= 2u;
+            next = false;
+        } else {
+            let ga = eval_point(o + t0 * dir).x;
+            let gb = eval_point(o + t1 * dir).x;
+            if ((ga <= 0.0) != (gb <= 0.0)) {
+                a = t0; b = t1; fa = ga; fb = gb;
+                found = true;
+                break;
             }
-            return 0.5 * (a + b);
+            if (any_solid || ga <= 0.0) {
+                st.t = tc;
+                if (ga <= 0.0) { st.t = t0; }
+                st.done = true;
+                return st;
+            }
+            if (st.candidate < 0.0) {
+                st.candidate = tc;
+                st.limit = s.y + pixel_cells * min_cell;
+            }
         }
-        if (any_solid || fa <= 0.0) {
-            if (fa <= 0.0) { return a; }
-            return tc;
-        }
-        if (candidate < 0.0) {
-            candidate = tc;
-            limit = s.y + pixel_cells * min_cell;
+        if (next) {
+            // The next node in depth-first order: up past every level where this node is a
+            // right child, then its right sibling; done when that climbs past the root.
+            let up = countTrailingZeros(~st.i);
+            if (up >= st.d) { st.done = true; break; }
+            st.d -= up;
+            st.i = (st.i >> up) + 1u;
         }
     }
-    return candidate;
+    if (!found) {
+        if (st.done) { st.t = st.candidate; }
+        return st;
+    }
+    var side = 0;
+    for (var it = 0; it < REFINE_STEPS; it++) {
+        var c = (a * fb - b * fa) / (fb - fa);
+        if (!(c > a && c < b)) { c = 0.5 * (a + b); }
+        let fc = eval_point(o + c * dir).x;
+        if ((fc < 0.0) == (fa < 0.0)) {
+            a = c; fa = fc;
+            if (side == -1) { fb *= 0.5; }
+            side = -1;
+        } else {
+            b = c; fb = fc;
+            if (side == 1) { fa *= 0.5; }
+            side = 1;
+        }
+    }
+    st.t = 0.5 * (a + b);
+    st.done = true;
+    return st;
 }
 
-// Per pixel: (distance along the unit ray, normal) or (-1, 0, 0, 0).
+// One round of the per-pixel search: (distance along the unit ray, state, 0, 0) in `hits`,
+// state 1 while searching and 2 when done (the normals pass then writes the normal). A pixel
+// takes at most `frame.depth.w` steps per round; the host runs rounds until none is left.
 @compute @workgroup_size(8, 8)
 fn pixel(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = frame.size.x;
     let h = frame.size.y;
     if (id.x >= w || id.y >= h) { return; }
+    let i = id.y * w + id.x;
+    let prev = hits[i];
+    if (prev.y == 2.0) { return; }
     var r: vec2<f32>;
     if (frame.level.w == 1u) {
-        r = parent_ranges[0];
+        r = parent_ranges[0].xy;
     } else {
-        r = parent_ranges[(id.y / 2u) * frame.level.z + id.x / 2u];
+        r = parent_ranges[(id.y / 2u) * frame.level.z + id.x / 2u].xy;
     }
-    let i = id.y * w + id.x;
-    hits[i] = vec4<f32>(-1.0, 0.0, 0.0, 0.0);
     // Never true: keeps `out_ranges` in this entry's automatic layout.
-    if (w == 0u) { out_ranges[0] = vec2<f32>(0.0); }
-    if (r.x > r.y) { return; }
+    if (w == 0u) { out_ranges[0] = vec4<f32>(0.0); }
+    if (r.x > r.y) { hits[i] = vec4<f32>(-1.0, 2.0, 0.0, 0.0); return; }
+    var st = Search(0u, 0u, -1.0, INF, false, -1.0);
+    if (prev.y == 1.0) {
+        let saved = search[i];
+        st = Search(u32(saved.x), u32(saved.y), saved.z, saved.w, false, -1.0);
+    }
     let x = screen_x(f32(id.x) + 0.5);
     let y = screen_y(f32(id.y) + 0.5);
     let f = frame.forward.xyz;
@@ -433,9 +513,16 @@ fn pixel(@builtin(global_invocation_id) id: vec3<u32>) {
     let u = frame.up.xyz;
     let d = vec3<f32>(f.x + x * rt.x + y * u.x, f.y + x * rt.y + y * u.y, f.z + x * rt.z + y * u.z);
     let len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    let z = line_search(vec3<f32>(0.0), d, r, frame.depth.z, false);
-    if (z < 0.0) { return; }
-    hits[i] = vec4<f32>(z * len, 0.0, 0.0, 0.0);
+    st = line_search(vec3<f32>(0.0), d, r, frame.depth.z, false, st, u32(frame.depth.w));
+    if (!st.done) {
+        search[i] = vec4<f32>(f32(st.d), f32(st.i), st.candidate, st.limit);
+        hits[i] = vec4<f32>(-1.0, 1.0, 0.0, 0.0);
+        atomicAdd(&unfinished[frame.level.y], 1u);
+        return;
+    }
+    var t = -1.0;
+    if (st.t >= 0.0) { t = st.t * len; }
+    hits[i] = vec4<f32>(t, 2.0, 0.0, 0.0);
 }
 
 // Per hit pixel: the normal, in a dispatch of its own (computed after `line_search` in the same
@@ -445,10 +532,10 @@ fn normals(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = frame.size.x;
     let h = frame.size.y;
     if (id.x >= w || id.y >= h) { return; }
-    if (w == 0u) { out_ranges[0] = vec2<f32>(parent_ranges[0]); }
+    if (w == 0u) { out_ranges[0] = parent_ranges[0]; }
     let i = id.y * w + id.x;
     let t = hits[i].x;
-    if (t < 0.0) { return; }
+    if (t < 0.0) { hits[i] = vec4<f32>(-1.0, 0.0, 0.0, 0.0); return; }
     let x = screen_x(f32(id.x) + 0.5);
     let y = screen_y(f32(id.y) + 0.5);
     let f = frame.forward.xyz;

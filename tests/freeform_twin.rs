@@ -98,12 +98,80 @@ fn bundled(name: &str) -> (Field, FreeformCamera) {
     (Field::compile(&s.shape).unwrap(), s.camera.unwrap())
 }
 
+/// Per pixel: GPU against twin (mask differences, worst depth and normal), twin against the f64
+/// caster (mask differences, on-another-surface count, worst depth).
+struct Agreement {
+    mask_diff: usize,
+    worst_depth: f32,
+    worst_normal: f32,
+    hit_pixels: usize,
+    /// Hit pixels where the GPU's depth is off by more than 1e-4 relative or its normal by more
+    /// than 1e-3 (not in the worst values).
+    outliers: usize,
+    f64_diff: usize,
+    f64_other_surface: usize,
+    worst_f64_depth: f64,
+}
+
+fn agreement(
+    twin: &[Option<(f32, [f32; 3])>],
+    gpu_hits: &[[f32; 4]],
+    f64_hits: &[Option<f64>],
+) -> Agreement {
+    let mut a = Agreement {
+        mask_diff: 0,
+        worst_depth: 0.0,
+        worst_normal: 0.0,
+        hit_pixels: 0,
+        outliers: 0,
+        f64_diff: 0,
+        f64_other_surface: 0,
+        worst_f64_depth: 0.0,
+    };
+    for i in 0..twin.len() {
+        let g = gpu_hits[i];
+        match (twin[i], g[0] >= 0.0) {
+            (Some((t, n)), true) => {
+                a.hit_pixels += 1;
+                let rel = (g[0] - t).abs() / t;
+                let dn = (0..3).map(|k| (g[1 + k] - n[k]).abs()).fold(0.0, f32::max);
+                if rel > 1e-4 || dn > 1e-3 {
+                    a.outliers += 1;
+                } else {
+                    a.worst_depth = a.worst_depth.max(rel);
+                    a.worst_normal = a.worst_normal.max(dn);
+                }
+            }
+            (None, false) => {}
+            _ => a.mask_diff += 1,
+        }
+        match (twin[i], f64_hits[i]) {
+            (Some((t, _)), Some(r)) => {
+                let rel = (t as f64 - r).abs() / r;
+                if rel > 1e-3 {
+                    a.f64_other_surface += 1;
+                } else {
+                    a.worst_f64_depth = a.worst_f64_depth.max(rel);
+                }
+            }
+            (None, None) => {}
+            _ => a.f64_diff += 1,
+        }
+    }
+    a
+}
+
 #[test]
 fn gpu_returns_the_twin_and_the_twin_the_f64_caster() {
     let Some(gpu) = common::gpu() else { return };
     let caster = relume::gpu::freeform_caster::FreeformCaster::new(&gpu).unwrap();
     let params = RmlrcParams::default();
-    for name in ["csg-holes.ron", "terrain-16.ron", "blobs-128.ron"] {
+    for name in [
+        "csg-holes.ron",
+        "terrain-16.ron",
+        "blobs-128.ron",
+        "bench/terrain-256.ron",
+    ] {
         let (field, camera) = bundled(name);
         let view = View::new(&camera, 96, 72);
         let v32 = View32::of(&view);
@@ -114,60 +182,76 @@ fn gpu_returns_the_twin_and_the_twin_the_f64_caster() {
             .cast(&gpu, &gf, &v32, params.top_level, params.refine, prune)
             .unwrap();
         let (f64_hits, _) = cast(&field, &view, &params);
-        let mut mask_diff = 0;
-        let mut worst_depth = 0f32;
-        let mut worst_normal = 0f32;
-        let mut f64_diff = 0;
-        let mut hit_pixels = 0;
-        let mut outliers = 0;
-        let mut f64_other_surface = 0;
-        let mut worst_f64_depth = 0f64;
-        for i in 0..twin.len() {
-            let g = gpu_hits[i];
-            match (twin[i], g[0] >= 0.0) {
-                (Some((t, n)), true) => {
-                    hit_pixels += 1;
-                    let rel = (g[0] - t).abs() / t;
-                    let dn = (0..3).map(|k| (g[1 + k] - n[k]).abs()).fold(0.0, f32::max);
-                    if rel > 1e-4 || dn > 1e-3 {
-                        outliers += 1;
-                    } else {
-                        worst_depth = worst_depth.max(rel);
-                        worst_normal = worst_normal.max(dn);
-                    }
-                }
-                (None, false) => {}
-                _ => mask_diff += 1,
-            }
-            match (twin[i], f64_hits[i]) {
-                (Some((t, _)), Some(r)) => {
-                    let rel = (t as f64 - r).abs() / r;
-                    if rel > 1e-3 {
-                        f64_other_surface += 1;
-                    } else {
-                        worst_f64_depth = worst_f64_depth.max(rel);
-                    }
-                }
-                (None, None) => {}
-                _ => f64_diff += 1,
-            }
-        }
+        let a = agreement(&twin, &gpu_hits, &f64_hits);
         eprintln!(
-            "{name}: gpu vs twin: {mask_diff} hit-mask differences, depth {worst_depth:.2e} rel, normal {worst_normal:.2e}; {outliers} outliers of {hit_pixels} hits; twin vs f64: {f64_diff} differences, depth {worst_f64_depth:.2e} rel ({f64_other_surface} on another surface)"
+            "{name}: gpu vs twin: {} hit-mask differences, depth {:.2e} rel, normal {:.2e}, {} outliers of {} hits; twin vs f64: {} differences, depth {:.2e} rel ({} on another surface)",
+            a.mask_diff, a.worst_depth, a.worst_normal, a.outliers, a.hit_pixels, a.f64_diff, a.worst_f64_depth, a.f64_other_surface
         );
-        assert_eq!(mask_diff, 0, "{name}");
-        // Depth within 1e-4 relative and normals within 1e-3 on all but 1.5 % of the hit
-        // pixels. Measured (96x72): 0 outliers on csg-holes and terrain-16; on blobs-128
-        // (128 perturbations summed in f32, where the driver may fuse multiply-adds the twin
-        // rounds twice) 27 of 2,406 hits (1.1 %).
-        assert!(worst_depth < 1e-4 && worst_normal < 1e-3, "{name}");
+        assert_eq!(a.mask_diff, 0, "{name}");
+        // Depth within 1e-4 relative and normal within 1e-3 on every hit pixel (measured: depth
+        // 0 and normal 6e-8 on csg-holes and terrain-16; on blobs-128, where the driver may
+        // fuse multiply-adds the twin rounds twice, 6.6e-5 and 9.2e-4) — except on terrain-256,
+        // whose field sums 256 overlapping cubic terms in f32: there the driver's roundings
+        // pick another root than the twin's on 146 of 6,624 hit pixels (2.2 %; the twin itself
+        // is on another surface than the f64 caster on 114), bounded at 5 %.
+        let allowed = if name.contains("256") {
+            a.hit_pixels * 5 / 100
+        } else {
+            0
+        };
         assert!(
-            outliers * 1000 <= 15 * hit_pixels,
-            "{name}: {outliers} of {hit_pixels}"
+            a.outliers <= allowed,
+            "{name}: {} of {} hits off",
+            a.outliers,
+            a.hit_pixels
         );
         // The twin against the f64 caster: hit/miss on all but 0.2 % of pixels (silhouettes,
         // where the widened f32 bound keeps a grazing cell the f64 one culls). Measured: 0, 0
         // and 9 of 6,912 (0.13 %, blobs-128).
-        assert!(f64_diff * 500 <= twin.len(), "{name}: {f64_diff}");
+        assert!(a.f64_diff * 500 <= twin.len(), "{name}: {}", a.f64_diff);
     }
+}
+
+/// Lavapipe ends an invocation's loops after 65,535 iterations in all, so the kernel splits
+/// each level's depth walk into passes and each pixel's search into rounds that resume where
+/// the last stopped. With a budget of 4,096 loop iterations per pass (16 times less than the
+/// default) terrain-64 needs many of both, and must return what one uninterrupted search
+/// returns: the twin's hits, to the same tolerances.
+#[test]
+fn a_search_split_into_rounds_returns_what_one_search_returns() {
+    let Some(gpu) = common::gpu() else { return };
+    let caster = relume::gpu::freeform_caster::FreeformCaster::new(&gpu)
+        .unwrap()
+        .with_pass_loops(4096);
+    let params = RmlrcParams::default();
+    let (field, camera) = bundled("bench/terrain-64.ron");
+    let view = View::new(&camera, 96, 72);
+    let v32 = View32::of(&view);
+    let gf = GpuField::upload(&field, view.eye).unwrap();
+    let prune = camera_outside(&field, &view, Bound::Affine);
+    let twin = cast32(&gf, &v32, params.top_level, params.refine, prune);
+    let out = caster
+        .cast_levels(&gpu, &gf, &v32, params.top_level, params.refine, prune, true)
+        .unwrap();
+    let (f64_hits, _) = cast(&field, &view, &params);
+    let a = agreement(&twin, &out.hits, &f64_hits);
+    eprintln!(
+        "terrain-64 in {} tile passes and {} pixel rounds: {} mask differences, depth {:.2e}, normal {:.2e} over {} hits",
+        out.tile_passes, out.pixel_rounds, a.mask_diff, a.worst_depth, a.worst_normal, a.hit_pixels
+    );
+    assert!(out.pixel_rounds >= 3, "{} rounds", out.pixel_rounds);
+    assert!(out.tile_passes >= 10, "{} passes", out.tile_passes);
+    // Every level's ranges equal the twin's exactly: the passes walk the same cells in order.
+    let levels = relume::freeform::twin_cast::levels32(&gf, &v32, params.top_level, prune);
+    assert_eq!(levels.len(), out.levels.len());
+    for (l, (t, g)) in levels.iter().zip(&out.levels).enumerate() {
+        let differ = t
+            .iter()
+            .zip(g)
+            .filter(|(a, b)| (a[0] > a[1]) != (b[0] > b[1]) || (a[0] <= a[1] && a != b))
+            .count();
+        assert_eq!(differ, 0, "level {l}");
+    }
+    assert_eq!(a.mask_diff, 0);
+    assert_eq!(a.outliers, 0);
 }

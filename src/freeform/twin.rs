@@ -28,8 +28,6 @@ use crate::error::{Error, Result};
 pub const SYMBOLS32: usize = 8;
 /// The CSG stack depth the kernel supports.
 pub const MAX_STACK: usize = 8;
-/// Depth of the kernel's per-pixel subdivision stack.
-pub const MAX_DFS: usize = 48;
 
 const KC: f32 = 9.536_743e-7; // 2^-20
 const KQ: f32 = 1.525_878_9e-5; // 2^-16
@@ -88,6 +86,20 @@ fn recentre(q: &Quad, eye: [f64; 3]) -> GpuQuad {
 }
 
 impl GpuField {
+    /// Loop iterations of one evaluation of the field by the kernel: one per operation and one
+    /// per perturbation of every surface it evaluates (nothing else in `field_range` or
+    /// `eval_point` loops). Lavapipe bounds the iterations of an invocation; the caster plans its
+    /// passes by this.
+    pub fn evaluation_loops(&self) -> u32 {
+        let bumps: u32 = self
+            .ops
+            .iter()
+            .filter(|op| *op >> 24 == 0)
+            .map(|op| self.leaves[(op & 0xffff) as usize].range[1])
+            .sum();
+        self.ops.len() as u32 + bumps
+    }
+
     /// The field relative to `eye`, refused when its CSG stack is deeper than the kernel's.
     pub fn upload(field: &Field, eye: [f64; 3]) -> Result<GpuField> {
         let mut depth = 0usize;
@@ -185,8 +197,23 @@ impl Cell32 {
     }
 
     fn extent(&self) -> [f32; 3] {
-        std::array::from_fn(|k| self.v.iter().map(|g| g[k].abs()).sum())
+        std::array::from_fn(|k| sum8_abs(self.component(k)))
     }
+
+    /// Component `k` of the eight generators.
+    fn component(&self, k: usize) -> [f32; SYMBOLS32] {
+        self.v.map(|g| g[k])
+    }
+}
+
+/// `Σ|vₖ|` in the kernel's order: `sum4(abs(v0..3)) + sum4(abs(v4..7))`, pairwise in each.
+fn sum8_abs(v: [f32; SYMBOLS32]) -> f32 {
+    sum8(v.map(f32::abs))
+}
+
+/// `Σvₖ` in the kernel's order.
+fn sum8(v: [f32; SYMBOLS32]) -> f32 {
+    ((v[0] + v[1]) + (v[2] + v[3])) + ((v[4] + v[5]) + (v[6] + v[7]))
 }
 
 /// An f32 affine form.
@@ -199,16 +226,14 @@ pub struct Aff32 {
 
 impl Aff32 {
     fn magnitude(&self) -> f32 {
-        self.g
-            .iter()
-            .fold(self.x0.abs() + self.e, |s, g| s + g.abs())
+        (self.x0.abs() + self.e) + sum8_abs(self.g)
     }
     fn widen(&mut self) {
         self.e += KR * self.magnitude() + TINY;
     }
     /// The widened interval of the form.
     pub fn range(&self) -> (f32, f32) {
-        let r = self.g.iter().fold(self.e, |s, g| s + g.abs());
+        let r = self.e + sum8_abs(self.g);
         let r = r + KR * (r + self.x0.abs()) + TINY;
         (self.x0 - r, self.x0 + r)
     }
@@ -251,40 +276,38 @@ fn mat_vec(a: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
     [dot3(a[0], v), dot3(a[1], v), dot3(a[2], v)]
 }
 
-/// A quadric over an f32 cell, widened. (Indexed loops: they mirror the kernel's.)
-#[allow(clippy::needless_range_loop)]
+/// A quadric over an f32 cell, widened, in the kernel's order of operations.
 pub fn quad_aff32(q: &GpuQuad, cell: &Cell32) -> Aff32 {
     let (a, b, c0) = unpack(q);
     let ac = mat_vec(&a, cell.c);
     let gc: [f32; 3] = std::array::from_fn(|i| ac[i] + b[i]);
-    let mut out = Aff32 {
-        x0: dot3(ac, cell.c) + 2.0 * dot3(b, cell.c) + c0,
-        g: [0.0; SYMBOLS32],
-        e: 0.0,
+    let (vx, vy, vz) = (cell.component(0), cell.component(1), cell.component(2));
+    let g = std::array::from_fn(|k| 2.0 * (gc[0] * vx[k] + gc[1] * vy[k] + gc[2] * vz[k]));
+    // A·v_k for the eight generators, by component.
+    let av = |i: usize| -> [f32; SYMBOLS32] {
+        std::array::from_fn(|k| a[i][0] * vx[k] + a[i][1] * vy[k] + a[i][2] * vz[k])
     };
-    let mut av = [[0.0f32; 3]; SYMBOLS32];
-    for k in 0..SYMBOLS32 {
-        out.g[k] = 2.0 * dot3(gc, cell.v[k]);
-        av[k] = mat_vec(&a, cell.v[k]);
-    }
+    let (ax, ay, az) = (av(0), av(1), av(2));
+    let d: [f32; SYMBOLS32] =
+        std::array::from_fn(|k| vx[k] * ax[k] + vy[k] * ay[k] + vz[k] * az[k]);
+    let x0 = (dot3(ac, cell.c) + 2.0 * dot3(b, cell.c) + c0) + 0.5 * sum8(d);
+    let mut total = 0.0f32;
     for j in 0..SYMBOLS32 {
-        let mjj = dot3(cell.v[j], av[j]);
-        out.x0 += 0.5 * mjj;
-        out.e += 0.5 * mjj.abs();
-        for k in j + 1..SYMBOLS32 {
-            out.e += 2.0 * dot3(cell.v[j], av[k]).abs();
-        }
+        let row = std::array::from_fn(|k| vx[j] * ax[k] + vy[j] * ay[k] + vz[j] * az[k]);
+        total += sum8_abs(row);
     }
-    let x: [f32; 3] = std::array::from_fn(|k| cell.c[k].abs() + cell.extent()[k]);
-    let mut m = c0.abs();
-    for i in 0..3 {
-        m += 2.0 * b[i].abs() * x[i];
-        for j in 0..3 {
-            m += a[i][j].abs() * x[i] * x[j];
-        }
-    }
-    out.e += KQ * m + TINY;
-    out
+    // ½Σ|M_jj| + 2Σ_{j<k}|M_jk| = Σ_jk|M_jk| − ½Σ|M_jj|.
+    let mut e = total - 0.5 * sum8_abs(d);
+    let ext = cell.extent();
+    let x: [f32; 3] = std::array::from_fn(|k| cell.c[k].abs() + ext[k]);
+    let ax3: [f32; 3] = std::array::from_fn(|i| {
+        a[i][0].abs() * x[0] + a[i][1].abs() * x[1] + a[i][2].abs() * x[2]
+    });
+    let m = c0.abs()
+        + 2.0 * (b[0].abs() * x[0] + b[1].abs() * x[1] + b[2].abs() * x[2])
+        + (x[0] * ax3[0] + x[1] * ax3[1] + x[2] * ax3[2]);
+    e += KQ * m + TINY;
+    Aff32 { x0, g, e }
 }
 
 fn cube0(t: f32) -> f32 {

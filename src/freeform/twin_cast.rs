@@ -2,7 +2,7 @@
 //! then the pixel pass — the algorithm of [`super::rmlrc`] in f32 with the widened bound of
 //! [`super::twin`], and the eye at the origin.
 
-use super::twin::{exp32, field_range32, GpuField, GpuQuad, View32, MAX_DFS};
+use super::twin::{exp32, field_range32, GpuField, GpuQuad, View32};
 
 /// A tile's log-depth range; empty when `lo > hi`.
 pub type Range32 = [f32; 2];
@@ -142,17 +142,90 @@ pub fn line32(
     min_cell: f32,
     any_solid: bool,
 ) -> Option<f32> {
-    let mut stack = [[0.0f32; 2]; MAX_DFS];
-    let mut sp = 1;
-    stack[0] = range;
+    line32_steps(f, o, d, range, min_cell, any_solid).0
+}
+
+/// [`line32`] and the number of steps it took (nodes bounded), which with the refinement's
+/// evaluations sets the kernel's loop iterations for the pixel.
+pub fn line32_steps(
+    f: &GpuField,
+    o: [f32; 3],
+    d: [f32; 3],
+    range: Range32,
+    min_cell: f32,
+    any_solid: bool,
+) -> (Option<f32>, u32) {
+    let mut st = Search32::START;
+    let mut steps = 0;
+    while !st.done {
+        st = line32_resume(f, o, d, range, min_cell, any_solid, st, 1);
+        steps += 1;
+    }
+    ((st.t >= 0.0).then_some(st.t), steps)
+}
+
+/// Where a pixel's search stands between rounds (the kernel's `Search`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Search32 {
+    /// Depth and index of the next node of the binary subdivision of the range.
+    pub d: u32,
+    pub i: u32,
+    /// A cell where the field straddles zero without a sign change at its ends (−1: none), and
+    /// how far past it the search still looks for a sign change.
+    pub candidate: f32,
+    pub limit: f32,
+    pub done: bool,
+    /// The result once done: t along `d`, or −1.
+    pub t: f32,
+}
+
+impl Search32 {
+    pub const START: Search32 = Search32 {
+        d: 0,
+        i: 0,
+        candidate: -1.0,
+        limit: f32::INFINITY,
+        done: false,
+        t: -1.0,
+    };
+}
+
+/// Deepest node of the search (indices stay exact in f32).
+pub const MAX_DEPTH: u32 = 24;
+/// Illinois steps refining a sign change.
+pub const REFINE_STEPS: usize = 24;
+
+/// Bounds of node (d, i) of the subdivision of `range`, as the kernel's `node_bounds`.
+pub fn node_bounds(range: Range32, d: u32, i: u32) -> Range32 {
+    let len = range[1] - range[0];
+    let scale = f32::from_bits((127 - d) << 23); // 2^-d, exact
+    [
+        range[0] + len * (i as f32 * scale),
+        range[0] + len * ((i + 1) as f32 * scale),
+    ]
+}
+
+/// Up to `steps` steps of the stackless depth-first search, from `st` (the kernel's
+/// `line_search`): a step bounds one node and culls it, splits it or tests its end points; a
+/// sign change is refined at once.
+#[allow(clippy::too_many_arguments)]
+pub fn line32_resume(
+    f: &GpuField,
+    o: [f32; 3],
+    d: [f32; 3],
+    range: Range32,
+    min_cell: f32,
+    any_solid: bool,
+    mut st: Search32,
+    steps: u32,
+) -> Search32 {
     let at = |t: f32| -> [f32; 3] { std::array::from_fn(|k| o[k] + t * d[k]) };
     let pixel_cells = ((range[1] - range[0]) / min_cell).min(64.0);
-    let mut candidate = -1.0f32;
-    let mut limit = f32::INFINITY;
-    while sp > 0 {
-        sp -= 1;
-        let [s0, s1] = stack[sp];
-        if candidate >= 0.0 && s0 >= limit {
+    let mut bracket = None;
+    for _ in 0..steps {
+        let [s0, s1] = node_bounds(range, st.d, st.i);
+        if st.candidate >= 0.0 && s0 >= st.limit {
+            st.done = true;
             break;
         }
         let (t0, t1) = (exp32(s0), exp32(s1));
@@ -161,82 +234,95 @@ pub fn line32(
         v5[0] = d.map(|x| tr * x);
         let cell = super::twin::Cell32::new(at(tc), v5);
         let (lo, hi) = field_range32(f, &cell);
+        let mut next = true;
         if !(lo <= 0.0 && hi >= 0.0) {
             if any_solid && hi < 0.0 {
-                return Some(tc);
+                return Search32 { t: tc, done: true, ..st };
             }
-            continue;
-        }
-        if s1 - s0 > min_cell && sp + 2 <= MAX_DFS {
-            let m = 0.5 * (s0 + s1);
-            stack[sp] = [m, s1];
-            stack[sp + 1] = [s0, m];
-            sp += 2;
-            continue;
-        }
-        let (mut a, mut b) = (t0, t1);
-        let (mut fa, mut fb) = (eval32(f, at(a)).0, eval32(f, at(b)).0);
-        if (fa <= 0.0) != (fb <= 0.0) {
-            // Illinois regula falsi, fixed count (the kernel's loop).
-            let mut side = 0;
-            for _ in 0..24 {
-                let mut c = (a * fb - b * fa) / (fb - fa);
-                if !(c > a && c < b) {
-                    c = 0.5 * (a + b);
-                }
-                let fc = eval32(f, at(c)).0;
-                if (fc < 0.0) == (fa < 0.0) {
-                    a = c;
-                    fa = fc;
-                    if side == -1 {
-                        fb *= 0.5;
-                    }
-                    side = -1;
-                } else {
-                    b = c;
-                    fb = fc;
-                    if side == 1 {
-                        fa *= 0.5;
-                    }
-                    side = 1;
-                }
+        } else if s1 - s0 > min_cell && st.d < MAX_DEPTH {
+            st.d += 1;
+            st.i *= 2;
+            next = false;
+        } else {
+            let (fa, fb) = (eval32(f, at(t0)).0, eval32(f, at(t1)).0);
+            if (fa <= 0.0) != (fb <= 0.0) {
+                bracket = Some((t0, t1, fa, fb));
+                break;
             }
-            return Some(0.5 * (a + b));
+            if any_solid || fa <= 0.0 {
+                let t = if fa <= 0.0 { t0 } else { tc };
+                return Search32 { t, done: true, ..st };
+            }
+            if st.candidate < 0.0 {
+                st.candidate = tc;
+                st.limit = s1 + pixel_cells * min_cell;
+            }
         }
-        if any_solid || fa <= 0.0 {
-            return Some(if fa <= 0.0 { a } else { tc });
-        }
-        if candidate < 0.0 {
-            candidate = tc;
-            limit = s1 + pixel_cells * min_cell;
+        if next {
+            // Up past every level where this node is a right child, then its right sibling.
+            let up = (!st.i).trailing_zeros();
+            if up >= st.d {
+                st.done = true;
+                break;
+            }
+            st.d -= up;
+            st.i = (st.i >> up) + 1;
         }
     }
-    (candidate >= 0.0).then_some(candidate)
+    let Some((mut a, mut b, mut fa, mut fb)) = bracket else {
+        if st.done {
+            st.t = st.candidate;
+        }
+        return st;
+    };
+    // Illinois regula falsi, fixed count (the kernel's loop).
+    let mut side = 0;
+    for _ in 0..REFINE_STEPS {
+        let mut c = (a * fb - b * fa) / (fb - fa);
+        if !(c > a && c < b) {
+            c = 0.5 * (a + b);
+        }
+        let fc = eval32(f, at(c)).0;
+        if (fc < 0.0) == (fa < 0.0) {
+            a = c;
+            fa = fc;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = c;
+            fb = fc;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Search32 {
+        t: 0.5 * (a + b),
+        done: true,
+        ..st
+    }
 }
 
-/// The whole cast as the GPU runs it: per pixel (row-major) the distance along the unit ray and
-/// the unit normal, or `None`.
-pub fn cast32(
-    f: &GpuField,
-    v: &View32,
-    top_level: u32,
-    refine: u32,
-    prune: bool,
-) -> Vec<Option<(f32, [f32; 3])>> {
+/// The tile passes as the GPU runs them: per level (coarse to fine) the depth range of every
+/// tile, row-major. The last entry is what the pixel pass reads.
+pub fn levels32(f: &GpuField, v: &View32, top_level: u32, prune: bool) -> Vec<Vec<Range32>> {
     let (w, h) = (v.width as usize, v.height as usize);
-    let mut ranges: Vec<Range32> = vec![[v.near_ln, v.far_ln]];
+    let mut levels: Vec<Vec<Range32>> = Vec::new();
     let mut parent_cols = 1usize;
     for level in (1..=top_level).rev() {
         let size = 1usize << level;
         let (cols, rows) = (w.div_ceil(size), h.div_ceil(size));
         let ds = v.theta * size as f32;
+        let ranges = levels.last();
         let next: Vec<Range32> = (0..cols * rows)
             .map(|i| {
                 let (tx, ty) = (i % cols, i / cols);
-                let parent = if level == top_level {
-                    ranges[0]
-                } else {
-                    ranges[(ty / 2) * parent_cols + tx / 2]
+                let parent = match ranges {
+                    None => [v.near_ln, v.far_ln],
+                    Some(r) => r[(ty / 2) * parent_cols + tx / 2],
                 };
                 let x = [
                     v.screen_x((tx * size) as f32),
@@ -249,17 +335,31 @@ pub fn cast32(
                 tile32(f, v, x, y, parent, ds, prune)
             })
             .collect();
-        ranges = next;
+        levels.push(next);
         parent_cols = cols;
     }
+    levels
+}
+
+/// The whole cast as the GPU runs it: per pixel (row-major) the distance along the unit ray and
+/// the unit normal, or `None`.
+pub fn cast32(
+    f: &GpuField,
+    v: &View32,
+    top_level: u32,
+    refine: u32,
+    prune: bool,
+) -> Vec<Option<(f32, [f32; 3])>> {
+    let (w, h) = (v.width as usize, v.height as usize);
+    let levels = levels32(f, v, top_level, prune);
+    let parent_cols = if top_level == 0 { 1 } else { w.div_ceil(2) };
     let min_cell = v.theta / (1u32 << refine) as f32;
     (0..w * h)
         .map(|i| {
             let (px, py) = (i % w, i / w);
-            let r = if top_level == 0 {
-                ranges[0]
-            } else {
-                ranges[(py / 2) * parent_cols + px / 2]
+            let r = match levels.last() {
+                None => [v.near_ln, v.far_ln],
+                Some(r) => r[(py / 2) * parent_cols + px / 2],
             };
             if r[0] > r[1] {
                 return None;
