@@ -68,8 +68,11 @@ fn main() {
                     let gf = GpuField::upload(&field, view.eye).unwrap();
                     let v32 = View32::of(&view);
                     let prune = camera_outside(&field, &view, Bound::Affine);
-                    c.cast(g, &gf, &v32, params.top_level, params.refine, prune)
-                        .unwrap(); // warm-up
+                    // Warm-up at a small size (the kernels are compiled already; this runs
+                    // the first dispatches and buffer creations).
+                    let small = View32::of(&View::new(scene.camera.as_ref().unwrap(), 32, 24));
+                    c.cast(g, &gf, &small, params.top_level, params.refine, prune)
+                        .unwrap();
                     let mut gpu_hits = 0;
                     let s = seconds(|| {
                         let out = c

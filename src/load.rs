@@ -3,6 +3,7 @@
 use crate::error::{Error, Result};
 use crate::heightmap::{load_heightmap, HeightMap, HeightMapInfo, HeightMapOptions};
 use crate::pipeline::Input;
+use crate::scene::freeform::{FreeformScene, HeightGrid};
 use crate::scene::{load_scene, LoadWarnings, Scene, SceneOptions};
 use serde::Serialize;
 use std::path::Path;
@@ -77,6 +78,38 @@ pub struct HeightMapSummary {
     pub nodata_count: usize,
     pub format: String,
     pub sample: String,
+}
+
+/// Read a freeform scene and the height maps its shape textures name (paths relative to the
+/// scene file; any height-map format, box-filtered by the grid's `downsample`), replacing each
+/// file grid by its samples.
+pub fn freeform_scene(path: &Path) -> Result<FreeformScene> {
+    let mut scene = FreeformScene::load(path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    for (i, t) in scene.shape.textured_mut().into_iter().enumerate() {
+        for grid in std::iter::once(&mut t.heights).chain(t.morph_to.as_mut()) {
+            if let HeightGrid::File {
+                path: file,
+                downsample,
+            } = grid
+            {
+                let opts = HeightMapOptions {
+                    downsample: *downsample,
+                    ..HeightMapOptions::default()
+                };
+                let (map, _) = load_heightmap(&dir.join(&*file), &opts)?;
+                *grid = HeightGrid::Grid {
+                    width: map.width,
+                    height: map.height,
+                    values: map.heights,
+                };
+            }
+        }
+        t.check().map_err(|m| {
+            Error::input(path, format!("shape texture {} (in file order): {m}", i + 1))
+        })?;
+    }
+    Ok(scene)
 }
 
 /// Summarise a loaded scene.

@@ -241,6 +241,10 @@ pub fn field_range(field: &Field, cell: &Cell, bound: Bound, work: &mut Work) ->
         Bound::Interval => {
             let leaf = |i: usize, work: &mut Work| {
                 let l = &field.leaves[i];
+                if let Some(t) = l.texture {
+                    work.terms += 1;
+                    return field.textures[t].range(lo, hi);
+                }
                 let mut r = quad_interval(&l.base, lo, hi);
                 work.terms += 1;
                 for b in &field.bumps[l.bumps.clone()] {
@@ -264,6 +268,10 @@ pub fn field_range(field: &Field, cell: &Cell, bound: Bound, work: &mut Work) ->
         Bound::Affine => {
             let leaf = |i: usize, work: &mut Work| {
                 let l = &field.leaves[i];
+                if let Some(t) = l.texture {
+                    work.terms += 1;
+                    return Affine::from_range(field.textures[t].range(lo, hi));
+                }
                 let mut r = quad_affine(&l.base, cell);
                 work.terms += 1;
                 for b in &field.bumps[l.bumps.clone()] {

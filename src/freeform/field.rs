@@ -9,6 +9,7 @@
 
 use crate::error::{Error, Result};
 use crate::scene::freeform::{Quadric, Shape, Transform};
+use super::texture::Texture;
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
 /// `pᵀ A p + 2 bᵀ p + c`.
@@ -111,6 +112,9 @@ pub struct Leaf {
     pub bumps: std::ops::Range<usize>,
     pub color: [f64; 3],
     pub specular: f64,
+    /// A shape texture (index into [`Field::textures`]): the leaf's field is the texture's,
+    /// its base quadric zero and its bump range empty.
+    pub texture: Option<usize>,
 }
 
 /// One instruction of the CSG program (postfix).
@@ -132,6 +136,7 @@ pub struct Field {
     pub leaves: Vec<Leaf>,
     pub bumps: Vec<Bump>,
     pub ops: Vec<Op>,
+    pub textures: Vec<Texture>,
 }
 
 /// The 4×4 object-frame matrix of a quadric (negative inside).
@@ -230,16 +235,32 @@ impl Field {
             leaves: Vec::new(),
             bumps: Vec::new(),
             ops: Vec::new(),
+            textures: Vec::new(),
         };
-        f.emit(shape);
+        f.emit(shape)?;
         if f.leaves.is_empty() {
             return Err(Error::knob("a freeform scene needs at least one surface"));
         }
         Ok(f)
     }
 
-    fn emit(&mut self, shape: &Shape) {
+    fn emit(&mut self, shape: &Shape) -> Result<()> {
         match shape {
+            Shape::Textured(t) => {
+                self.ops.push(Op::Leaf(self.leaves.len() as u32));
+                self.leaves.push(Leaf {
+                    base: Quad {
+                        a: [[0.0; 3]; 3],
+                        b: [0.0; 3],
+                        c: 0.0,
+                    },
+                    bumps: self.bumps.len()..self.bumps.len(),
+                    color: t.color,
+                    specular: t.specular,
+                    texture: Some(self.textures.len()),
+                });
+                self.textures.push(Texture::compile(t)?);
+            }
             Shape::Surface(s) => {
                 let start = self.bumps.len();
                 for p in &s.perturbations {
@@ -255,10 +276,13 @@ impl Field {
                     bumps: start..self.bumps.len(),
                     color: s.color,
                     specular: s.specular,
+                    texture: None,
                 });
             }
             Shape::Union(c) | Shape::Intersection(c) => {
-                c.iter().for_each(|c| self.emit(c));
+                for c in c {
+                    self.emit(c)?;
+                }
                 if c.len() > 1 {
                     let n = c.len() as u32;
                     self.ops.push(match shape {
@@ -268,18 +292,27 @@ impl Field {
                 }
             }
             Shape::Difference(a, b) => {
-                self.emit(a);
-                self.emit(b);
+                self.emit(a)?;
+                self.emit(b)?;
                 self.ops.push(Op::Neg);
                 self.ops.push(Op::Max(2));
             }
         }
+        Ok(())
+    }
+
+    /// Morph every shape texture to parameter `s` ∈ [0, 1] (those without a second grid stay).
+    pub fn set_morph(&mut self, s: f64) {
+        self.textures.iter_mut().for_each(|t| t.set_morph(s));
     }
 
     /// The field of leaf `i` at `p`.
     #[inline]
     pub fn leaf_value(&self, i: usize, p: [f64; 3]) -> f64 {
         let leaf = &self.leaves[i];
+        if let Some(t) = leaf.texture {
+            return self.textures[t].value(p);
+        }
         let mut v = leaf.base.eval(p);
         for b in &self.bumps[leaf.bumps.clone()] {
             if let Some((lo, hi)) = b.support {
@@ -298,6 +331,9 @@ impl Field {
     /// The gradient of leaf `i` at `p`.
     pub fn leaf_gradient(&self, i: usize, p: [f64; 3]) -> [f64; 3] {
         let leaf = &self.leaves[i];
+        if let Some(t) = leaf.texture {
+            return self.textures[t].gradient(p);
+        }
         let mut g = leaf.base.grad(p);
         for b in &self.bumps[leaf.bumps.clone()] {
             let q = b.q.eval(p);

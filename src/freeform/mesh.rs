@@ -99,6 +99,11 @@ pub fn polygonise(field: &Field, params: &MeshParams) -> Result<Mesh> {
 
 /// [`polygonise`], also reporting the spacing, curvature and passes.
 pub fn polygonise_with_stats(field: &Field, params: &MeshParams) -> Result<(Mesh, MeshStats)> {
+    if !field.textures.is_empty() {
+        return Err(Error::knob(
+            "freeform mesh does not take shape textures yet (its spacing comes from the quadrics' curvature): mesh the height grid as terrain instead",
+        ));
+    }
     let MeshParams { lo, hi, tolerance } = *params;
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(Error::knob(format!(
@@ -168,7 +173,12 @@ pub(super) fn restrict(field: &Field, lo: [f64; 3], hi: [f64; 3]) -> Field {
         leaves.push(Leaf { bumps, ..l.clone() });
     }
     let ops = field.ops.clone();
-    Field { leaves, bumps, ops }
+    Field {
+        leaves,
+        bumps,
+        ops,
+        textures: field.textures.clone(),
+    }
 }
 
 fn is_prime(n: u64) -> bool {

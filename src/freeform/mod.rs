@@ -6,6 +6,8 @@
 //! - [`poly`]: certified real roots of polynomials of degree ≤ 6;
 //! - [`reference`]: the exact per-ray cast every other method is tested against;
 //! - [`bounds`]: interval and affine bounds of the field over a view-pyramid cell;
+//! - [`texture`]: shape textures (a height grid displacing a plane or sphere), their bounds
+//!   from the min/max mipmap and their certified cast;
 //! - [`view`]: the f64 camera and its cells; [`rmlrc`]: the multilevel caster;
 //! - [`shade`]: normals, sun lighting and shadows, frames.
 //!
@@ -20,6 +22,7 @@ pub mod poly;
 pub mod reference;
 pub mod rmlrc;
 pub mod shade;
+pub mod texture;
 pub mod twin;
 pub mod twin_cast;
 pub mod view;

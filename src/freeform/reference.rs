@@ -65,6 +65,9 @@ pub fn leaf_solid(
     t1: f64,
 ) -> Vec<(f64, f64)> {
     let leaf = &field.leaves[i];
+    if let Some(t) = leaf.texture {
+        return field.textures[t].solid_along(o, d, t0, t1);
+    }
     let mut set: Set = Vec::new();
     let add = |a: f64, b: f64, set: &mut Set| match set.last_mut() {
         Some(last) if last.1 >= a => last.1 = last.1.max(b),

@@ -102,6 +102,12 @@ impl GpuField {
 
     /// The field relative to `eye`, refused when its CSG stack is deeper than the kernel's.
     pub fn upload(field: &Field, eye: [f64; 3]) -> Result<GpuField> {
+        if !field.textures.is_empty() {
+            return Err(Error::knob(format!(
+                "the GPU caster does not evaluate shape textures yet (this scene has {}): cast it on the CPU (--method rmlrc or reference)",
+                field.textures.len()
+            )));
+        }
         let mut depth = 0usize;
         let mut deepest = 0usize;
         // Min(n)/Max(n) become n − 1 binary ops, and every op names its stack slot (computed

@@ -10,6 +10,7 @@
 //! No-data texels (NaN, ±∞, or the file's/knob's no-data value) follow [`NoDataPolicy`]: an error
 //! by default, or filled with the minimum valid height or with the nearest valid height.
 
+pub mod minmax_mipmap;
 mod readers;
 
 use crate::error::{Error, Result};

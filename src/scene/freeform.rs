@@ -20,6 +20,8 @@ use ron::extensions::Extensions;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub use super::shape_texture::{Carrier, HeightGrid, TexturedSurface};
+
 /// The most perturbations one surface may carry (the GPU kernel's loop bound is the same).
 pub const MAX_PERTURBATIONS: usize = 4096;
 
@@ -79,6 +81,8 @@ pub struct SunAngles {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Shape {
     Surface(Box<Surface>),
+    /// A shape texture: a height grid displacing a carrier surface along its normal.
+    Textured(Box<TexturedSurface>),
     /// Points inside any child (`min` of the fields).
     Union(Vec<Shape>),
     /// Points inside every child (`max`).
@@ -104,10 +108,10 @@ pub struct Surface {
     pub specular: f64,
 }
 
-fn default_color() -> [f64; 3] {
+pub(super) fn default_color() -> [f64; 3] {
     [0.7, 0.7, 0.7]
 }
-fn default_specular() -> f64 {
+pub(super) fn default_specular() -> f64 {
     0.15
 }
 
@@ -251,6 +255,12 @@ impl FreeformScene {
                 ));
             }
         }
+        let mut textured = Vec::new();
+        self.shape.textured(&mut textured);
+        for (i, t) in textured.iter().enumerate() {
+            t.check()
+                .map_err(|m| format!("shape texture {} (in file order): {m}", i + 1))?;
+        }
         if let Some(c) = &self.camera {
             finite3(&c.eye).map_err(|m| format!("camera eye: {m}"))?;
             finite3(&c.target).map_err(|m| format!("camera target: {m}"))?;
@@ -292,6 +302,7 @@ impl Shape {
     pub fn surfaces<'a>(&'a self, out: &mut Vec<&'a Surface>) {
         match self {
             Shape::Surface(s) => out.push(s),
+            Shape::Textured(_) => {}
             Shape::Union(c) | Shape::Intersection(c) => c.iter().for_each(|c| c.surfaces(out)),
             Shape::Difference(a, b) => {
                 a.surfaces(out);
@@ -300,9 +311,38 @@ impl Shape {
         }
     }
 
+    /// The shape textures of the tree, in file order.
+    pub fn textured<'a>(&'a self, out: &mut Vec<&'a TexturedSurface>) {
+        match self {
+            Shape::Textured(t) => out.push(t),
+            Shape::Surface(_) => {}
+            Shape::Union(c) | Shape::Intersection(c) => c.iter().for_each(|c| c.textured(out)),
+            Shape::Difference(a, b) => {
+                a.textured(out);
+                b.textured(out);
+            }
+        }
+    }
+
+    /// The shape textures of the tree, mutable (the loader resolves their files).
+    pub fn textured_mut(&mut self) -> Vec<&mut TexturedSurface> {
+        match self {
+            Shape::Textured(t) => vec![t],
+            Shape::Surface(_) => Vec::new(),
+            Shape::Union(c) | Shape::Intersection(c) => {
+                c.iter_mut().flat_map(Shape::textured_mut).collect()
+            }
+            Shape::Difference(a, b) => {
+                let mut v = a.textured_mut();
+                v.extend(b.textured_mut());
+                v
+            }
+        }
+    }
+
     fn check_arity(&self) -> std::result::Result<(), String> {
         match self {
-            Shape::Surface(_) => Ok(()),
+            Shape::Surface(_) | Shape::Textured(_) => Ok(()),
             Shape::Union(c) | Shape::Intersection(c) => {
                 if c.is_empty() {
                     return Err("a Union or Intersection needs at least one child".into());
@@ -317,7 +357,7 @@ impl Shape {
     }
 }
 
-fn finite3(v: &[f64; 3]) -> std::result::Result<(), String> {
+pub(super) fn finite3(v: &[f64; 3]) -> std::result::Result<(), String> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
@@ -325,7 +365,7 @@ fn finite3(v: &[f64; 3]) -> std::result::Result<(), String> {
     }
 }
 
-fn positive(name: &str, v: f64) -> std::result::Result<(), String> {
+pub(super) fn positive(name: &str, v: f64) -> std::result::Result<(), String> {
     if v > 0.0 && v.is_finite() {
         Ok(())
     } else {

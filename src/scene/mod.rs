@@ -10,6 +10,7 @@ pub mod freeform;
 mod gltf_loader;
 mod obj_loader;
 pub mod punctual;
+pub mod shape_texture;
 
 use crate::error::{Error, Result};
 use glam::Vec3;

@@ -2,7 +2,8 @@
 //!
 //! - [`sun`]: the sun direction and its track in texel space (the constants every kernel uses);
 //! - [`exact_traversal`]: hard shadows by visiting every texel on the track (algorithm A1, the reference);
-//! - [`minmax_mipmap`]: the min/max mipmap (stored by `crate::baked::mipmap`);
+//! - [`minmax_mipmap`]: the min/max mipmap (in `heightmap`, the data layer, so that freeform
+//!   shape textures share it; stored by `crate::baked::mipmap`);
 //! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
 //! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
 //! - [`relief`]: whole-image shadow masks and shaded relief;
@@ -16,7 +17,7 @@ pub mod accelerated_traversal;
 pub mod exact_traversal;
 pub mod generate;
 pub mod hard_f32;
-pub mod minmax_mipmap;
+pub use crate::heightmap::minmax_mipmap;
 pub mod relief;
 pub mod soft;
 pub mod sun;

@@ -6,7 +6,7 @@ use relume::baked::images::{self, check_extension};
 use relume::error::exit;
 use relume::freeform::{self, Bound, Field, Lighting, Method, RmlrcParams, View};
 use relume::render::tonemap::linear_to_srgb8;
-use relume::scene::freeform::{FreeformCamera, FreeformScene};
+use relume::scene::freeform::FreeformCamera;
 use relume::{Error, Result};
 use serde_json::json;
 use std::path::PathBuf;
@@ -91,6 +91,9 @@ pub struct RenderArgs {
     /// No sun shadows
     #[arg(long)]
     pub no_shadows: bool,
+    /// Morph parameter of the shape textures, in [0, 1]: heights (1 − S)·heights + S·morph_to
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub morph: f64,
 }
 
 fn triple(s: &str) -> Result<[f64; 3], String> {
@@ -158,8 +161,15 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
     if let Some(d) = &a.depth {
         check_extension(d, &["exr"])?;
     }
-    let scene = FreeformScene::load(&a.scene)?;
-    let field = Field::compile(&scene.shape).map_err(|e| Error::input(&a.scene, e))?;
+    if !(0.0..=1.0).contains(&a.morph) {
+        return Err(Error::knob(format!(
+            "--morph must be in [0, 1], got {}",
+            a.morph
+        )));
+    }
+    let scene = relume::load::freeform_scene(&a.scene)?;
+    let mut field = Field::compile(&scene.shape).map_err(|e| Error::input(&a.scene, e))?;
+    field.set_morph(a.morph);
     let camera = a
         .camera
         .clone()
@@ -243,7 +253,7 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
 fn mesh(a: &MeshArgs, json: bool, quiet: bool) -> Result<i32> {
     use relume::freeform::mesh::{self, MeshParams};
     check_extension(&a.out, &["obj"])?;
-    let scene = FreeformScene::load(&a.scene)?;
+    let scene = relume::load::freeform_scene(&a.scene)?;
     let field = Field::compile(&scene.shape).map_err(|e| Error::input(&a.scene, e))?;
     let params = MeshParams {
         lo: a.bounds.0,

@@ -11,7 +11,7 @@
 //! border* (the 4×4 texels [2bx−1, 2bx+2] × [2by−1, 2by+2], clamped to the map) — the footprint
 //! of the relief-shadow paper's 3×3 pattern of bilinear samples, with texel values instead of averages. Why
 //! this is conservative for every value the exact traversal samples in the block: a sample of
-//! texel T is taken at a point Q clamped into T's square, and [`sample_bilinear`] clamps its
+//! texel T is taken at a point Q clamped into T's square, and `terrain::exact_traversal::sample_bilinear` clamps its
 //! result to the range of the four texels of Q's bilinear cell; for Q in T's square those four
 //! texels lie within one texel of T (border-clamped), hence inside the block's bordered
 //! footprint. So every sample h satisfies min ≤ h ≤ max, exactly, in floating point (no
@@ -21,8 +21,6 @@
 //!
 //! **Flat layout** (what the GPU uploads): `data` holds 2 f32 per texel, `max` then `min`, levels
 //! one after another; texel (bx, by) of level L is at `2 · (levels[L].offset + by · levels[L].width + bx)`.
-//!
-//! [`sample_bilinear`]: super::exact_traversal::sample_bilinear
 
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
@@ -149,6 +147,31 @@ impl MinMaxMipmap {
     /// Side of the block of height-map texels a texel of `level` bounds (without the border).
     pub fn block_size(level: usize) -> usize {
         2 << level
+    }
+
+    /// (max, min) bounding every sample with x index in `xs` and y index in `ys` (inclusive,
+    /// clamped to the map): the max/min of at most 2×2 texels of the finest level whose blocks
+    /// cover the rectangle in two per axis. Conservative, never tighter than the samples' range.
+    pub fn sample_range(&self, xs: (usize, usize), ys: (usize, usize)) -> (f32, f32) {
+        let clamp = |r: (usize, usize), n: usize| (r.0.min(n - 1), r.1.min(n - 1).max(r.0.min(n - 1)));
+        let (x0, x1) = clamp(xs, self.map_width);
+        let (y0, y1) = clamp(ys, self.map_height);
+        for (l, level) in self.levels.iter().enumerate() {
+            let b = Self::block_size(l);
+            let (bx0, bx1, by0, by1) = (x0 / b, x1 / b, y0 / b, y1 / b);
+            if bx1 - bx0 <= 1 && by1 - by0 <= 1 {
+                let (mut hi, mut lo) = (f32::NEG_INFINITY, f32::INFINITY);
+                for by in by0..=by1.min(level.height - 1) {
+                    for bx in bx0..=bx1.min(level.width - 1) {
+                        let (h, l) = self.texel(l, bx, by);
+                        hi = hi.max(h);
+                        lo = lo.min(l);
+                    }
+                }
+                return (hi, lo);
+            }
+        }
+        (self.max_height, self.min_height)
     }
 
     /// Bytes of the texel data (f32 pairs).
