@@ -41,6 +41,15 @@ demo: build
 	    --out out/demo/puget-sound-frames
 	$(PLAYER) out/demo/puget-sound-2k --headless --size 640x480 --sun 300,6 --soft \
 	    --out out/demo/puget-sound-soft-frames
+	@mkdir -p out/demo/freeform
+	for s in scenes/freeform/*.ron; do \
+	    $(BAKE) freeform render $$s --size 640x480 --quiet \
+	        --out out/demo/freeform/$$(basename $$s .ron).png || exit 1; \
+	done
+	for m in 0.5 1; do \
+	    $(BAKE) freeform render scenes/freeform/morph-grid.ron --size 640x480 --morph $$m --quiet \
+	        --out out/demo/freeform/morph-grid-$$m.png || exit 1; \
+	done
 	@echo
 	@echo "demo output is in out/demo/:"
 	@echo "  cornell/, puget-sound/, puget-sound-2k/        baked directories (relume-bake inspect DIR)"
@@ -52,6 +61,8 @@ demo: build
 	@echo "  puget-sound-frames/frame_000[0-1].png          player: Puget Sound 2K, hard relief shadows"
 	@echo "  puget-sound-soft-frames/frame_0000.png         player: Puget Sound 2K, soft shadows"
 	@echo "  */frames.json                                  adapter and per-pass frame times"
+	@echo "  freeform/*.png                                 every bundled freeform scene (CPU multilevel caster),"
+	@echo "                                                 morph-grid-0.5.png and -1.png the morph halfway and done"
 
 ## Every image the README and docs/ show, regenerated from the code into docs/images/ (player
 ## frames on the machine's GPU or Mesa lavapipe, terrain images, study plots). Deterministic for

@@ -95,12 +95,44 @@ pub fn text(data: &[u8]) {
         return;
     };
     let path = Path::new("fuzz.ron");
-    if sel % 2 == 0 {
-        if let Ok(p) = relume::pipeline::parse::parse_str(path, text) {
-            let _ = relume::pipeline::check_order(path, &p);
+    match sel % 3 {
+        0 => {
+            if let Ok(p) = relume::pipeline::parse::parse_str(path, text) {
+                let _ = relume::pipeline::check_order(path, &p);
+            }
         }
-    } else {
-        let _ = relume::baked::Manifest::from_ron(path, text);
+        1 => {
+            let _ = relume::baked::Manifest::from_ron(path, text);
+        }
+        _ => freeform(path, text),
+    }
+}
+
+/// A freeform scene: parsed and checked, compiled (shape textures included), uploaded for the
+/// GPU, evaluated at a few points and bounded over a few boxes — what `freeform render` does
+/// before casting.
+fn freeform(path: &Path, text: &str) {
+    use relume::freeform::bounds::{field_range, Bound, Cell, Work};
+    let Ok(scene) = relume::scene::freeform::FreeformScene::parse(path, text) else {
+        return;
+    };
+    let Ok(field) = relume::freeform::Field::compile(&scene.shape) else {
+        return;
+    };
+    let _ = relume::freeform::twin::GpuField::upload(&field, [0.1, 0.2, 0.3]);
+    for p in [[0.0, 0.0, 0.0], [1.0, -2.0, 0.5], [1e3, 1e-3, -7.0]] {
+        let _ = field.eval(p);
+        let _ = field.normal(p);
+        let mut cell = Cell {
+            c: p,
+            v: [[0.0; 3]; relume::freeform::bounds::SYMBOLS],
+        };
+        cell.v[0] = [0.5, 0.0, 0.0];
+        cell.v[1] = [0.0, 0.25, 0.0];
+        cell.v[2] = [0.1, 0.0, 1.0];
+        for bound in [Bound::Interval, Bound::Affine] {
+            let _ = field_range(&field, &cell, bound, &mut Work::default());
+        }
     }
 }
 

@@ -30,6 +30,9 @@ use crate::heightmap::HeightMap;
 use crate::scene::freeform::{Carrier, HeightGrid, TexturedSurface};
 use std::f64::consts::PI;
 
+/// Segments the reference bisects on one ray before it decides the rest by end points.
+pub const MAX_SEGMENTS: u32 = 1 << 22;
+
 /// The carrier's geometry in world space.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CarrierGeom {
@@ -125,7 +128,14 @@ impl Texture {
                 .map(|&x| (x as f64 * t.height_scale) as f32)
                 .collect()
         };
-        let (w, h, from) = filtered(w0, h0, &scale(a), t.lod);
+        let scaled = scale(a);
+        if scaled.iter().any(|v| !v.is_finite()) {
+            return Err(Error::knob(format!(
+                "heights x height_scale ({}) overflow single precision",
+                t.height_scale
+            )));
+        }
+        let (w, h, from) = filtered(w0, h0, &scaled, t.lod);
         let to = match &t.morph_to {
             Some(g) => {
                 let (wb, hb, b) = inline(g)?;
@@ -134,7 +144,14 @@ impl Texture {
                         "morph_to is {wb}x{hb}, heights {w0}x{h0}: a morph needs grids of one size"
                     )));
                 }
-                Some(filtered(wb, hb, &scale(b), t.lod).2)
+                let scaled = scale(b);
+                if scaled.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::knob(format!(
+                        "morph_to x height_scale ({}) overflows single precision",
+                        t.height_scale
+                    )));
+                }
+                Some(filtered(wb, hb, &scaled, t.lod).2)
             }
             None => None,
         };
@@ -439,7 +456,9 @@ impl Texture {
     /// The solid set along `o + t·d` within [t0, t1]: bisection on the bounds of segments,
     /// down to `1e-10·(1 + |t|)`, where the end points' signs decide and a sign change is
     /// refined by bisection on F to the last bit. Certified except for a tangent touch (F
-    /// reaching 0 without changing sign) inside one tolerance interval.
+    /// reaching 0 without changing sign) inside one tolerance interval, and beyond
+    /// [`MAX_SEGMENTS`] segments on one ray, where the segments left are decided by their end
+    /// points (a guard against pathological inputs; the bundled scenes stay far below it).
     pub fn solid_along(&self, o: [f64; 3], d: [f64; 3], t0: f64, t1: f64) -> Vec<(f64, f64)> {
         let mut out: Vec<(f64, f64)> = Vec::new();
         let at = |t: f64| -> [f64; 3] { std::array::from_fn(|k| o[k] + t * d[k]) };
@@ -448,7 +467,9 @@ impl Texture {
             _ => out.push((a, b)),
         };
         let mut stack = vec![(t0, t1)];
+        let mut budget = MAX_SEGMENTS;
         while let Some((a, b)) = stack.pop() {
+            budget = budget.saturating_sub(1);
             let (pa, pb) = (at(a), at(b));
             let lo: [f64; 3] = std::array::from_fn(|k| pa[k].min(pb[k]));
             let hi: [f64; 3] = std::array::from_fn(|k| pa[k].max(pb[k]));
@@ -460,7 +481,7 @@ impl Texture {
                 push(a, b, &mut out);
                 continue;
             }
-            if b - a > 1e-10 * (1.0 + a.abs().max(b.abs())) {
+            if b - a > 1e-10 * (1.0 + a.abs().max(b.abs())) && budget > 0 {
                 let m = 0.5 * (a + b);
                 stack.push((m, b));
                 stack.push((a, m));
