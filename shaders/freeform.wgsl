@@ -14,7 +14,8 @@ struct Frame {
     up: vec4<f32>,        // xyz, theta (one pixel's angle)
     depth: vec4<f32>,     // near_ln, far_ln, min_cell, depth cells per tile pass
     size: vec4<u32>,      // width, height, ops, prune
-    level: vec4<u32>,     // tile size, cols, parent_cols, is_top
+    level: vec4<u32>,     // tile size (pixel passes: unused), cols (pixel passes: round), parent_cols, is_top
+    sun: vec4<f32>,       // unit direction toward the sun, scene scale (shadow pass)
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -506,12 +507,7 @@ fn pixel(@builtin(global_invocation_id) id: vec3<u32>) {
         let saved = search[i];
         st = Search(u32(saved.x), u32(saved.y), saved.z, saved.w, false, -1.0);
     }
-    let x = screen_x(f32(id.x) + 0.5);
-    let y = screen_y(f32(id.y) + 0.5);
-    let f = frame.forward.xyz;
-    let rt = frame.right.xyz;
-    let u = frame.up.xyz;
-    let d = vec3<f32>(f.x + x * rt.x + y * u.x, f.y + x * rt.y + y * u.y, f.z + x * rt.z + y * u.z);
+    let d = pixel_dir(id.xy);
     let len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
     st = line_search(vec3<f32>(0.0), d, r, frame.depth.z, false, st, u32(frame.depth.w));
     if (!st.done) {
@@ -526,7 +522,8 @@ fn pixel(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Per hit pixel: the normal, in a dispatch of its own (computed after `line_search` in the same
-// invocation, lavapipe returned wrong normals: a large live state there).
+// invocation, lavapipe returned wrong normals: a large live state there), and the surface hit
+// into the shadow pass's state (status 0 = not searched yet, shadowed, leaf, 0).
 @compute @workgroup_size(8, 8)
 fn normals(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = frame.size.x;
@@ -535,16 +532,68 @@ fn normals(@builtin(global_invocation_id) id: vec3<u32>) {
     if (w == 0u) { out_ranges[0] = parent_ranges[0]; }
     let i = id.y * w + id.x;
     let t = hits[i].x;
-    if (t < 0.0) { hits[i] = vec4<f32>(-1.0, 0.0, 0.0, 0.0); return; }
-    let x = screen_x(f32(id.x) + 0.5);
-    let y = screen_y(f32(id.y) + 0.5);
+    if (t < 0.0) {
+        hits[i] = vec4<f32>(-1.0, 0.0, 0.0, 0.0);
+        out_ranges[i] = vec4<f32>(2.0, 0.0, 0.0, 0.0);
+        return;
+    }
+    let d = pixel_dir(id.xy);
+    let len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    let z = t / len;
+    let p = d * z;
+    var n = normal_at(p);
+    if (n.x * d.x + n.y * d.y + n.z * d.z > 0.0) { n = -n; }
+    hits[i] = vec4<f32>(t, n);
+    out_ranges[i] = vec4<f32>(0.0, 0.0, eval_point(p).y, 0.0);
+}
+
+// The ray through pixel `px` (not unit length).
+fn pixel_dir(px: vec2<u32>) -> vec3<f32> {
+    let x = screen_x(f32(px.x) + 0.5);
+    let y = screen_y(f32(px.y) + 0.5);
     let f = frame.forward.xyz;
     let rt = frame.right.xyz;
     let u = frame.up.xyz;
-    let d = vec3<f32>(f.x + x * rt.x + y * u.x, f.y + x * rt.y + y * u.y, f.z + x * rt.z + y * u.z);
+    return vec3<f32>(f.x + x * rt.x + y * u.x, f.y + x * rt.y + y * u.y, f.z + x * rt.z + y * u.z);
+}
+
+// Per hit pixel facing the sun: is the sun blocked? The same search toward the sun (any solid
+// cell ends it), from the hit point lifted off the surface, in rounds like `pixel`; state in
+// `out_ranges` as the normals pass left it (status 0 new, 1 searching, 2 done; shadowed; leaf).
+@compute @workgroup_size(8, 8)
+fn shadow(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = frame.size.x;
+    let h = frame.size.y;
+    if (id.x >= w || id.y >= h) { return; }
+    if (w == 0u) { out_ranges[0] = parent_ranges[0]; }
+    let i = id.y * w + id.x;
+    let s = out_ranges[i];
+    if (s.x == 2.0) { return; }
+    let hit = hits[i];
+    let l = frame.sun.xyz;
+    let n = hit.yzw;
+    if (dot3(n, l) <= 0.0) { out_ranges[i] = vec4<f32>(2.0, 0.0, s.z, 0.0); return; }
+    let d = pixel_dir(id.xy);
     let len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    let z = t / len;
-    var n = normal_at(d * z);
-    if (n.x * d.x + n.y * d.y + n.z * d.z > 0.0) { n = -n; }
-    hits[i] = vec4<f32>(t, n);
+    let t = hit.x;
+    let p = d * (t / len);
+    let eps = 1e-5 * max(t, frame.sun.w * 1e-3);
+    let o = p + eps * n;
+    let far = max(exp32(frame.depth.y), t) * 2.0;
+    let range = vec2<f32>(log(eps), log(far));
+    var st = Search(0u, 0u, -1.0, INF, false, -1.0);
+    if (s.x == 1.0) {
+        let saved = search[i];
+        st = Search(u32(saved.x), u32(saved.y), saved.z, saved.w, false, -1.0);
+    }
+    st = line_search(o, l, range, frame.depth.z, true, st, u32(frame.depth.w));
+    if (!st.done) {
+        search[i] = vec4<f32>(f32(st.d), f32(st.i), st.candidate, st.limit);
+        out_ranges[i] = vec4<f32>(1.0, 0.0, s.z, 0.0);
+        atomicAdd(&unfinished[frame.level.y], 1u);
+        return;
+    }
+    var shadowed = 0.0;
+    if (st.t >= 0.0) { shadowed = 1.0; }
+    out_ranges[i] = vec4<f32>(2.0, shadowed, s.z, 0.0);
 }

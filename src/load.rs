@@ -106,7 +106,10 @@ pub fn freeform_scene(path: &Path) -> Result<FreeformScene> {
             }
         }
         t.check().map_err(|m| {
-            Error::input(path, format!("shape texture {} (in file order): {m}", i + 1))
+            Error::input(
+                path,
+                format!("shape texture {} (in file order): {m}", i + 1),
+            )
         })?;
     }
     Ok(scene)

@@ -64,7 +64,11 @@ fn a_flat_grid_on_a_plane_carrier_is_that_plane() {
         "Freeform(shape: Surface(base: Plane(normal: (0.0, 1.0, 0.0), offset: 0.5)))",
     )
     .unwrap();
-    same_picture(&field, &Field::compile(&plane.shape).unwrap(), s.camera.as_ref().unwrap());
+    same_picture(
+        &field,
+        &Field::compile(&plane.shape).unwrap(),
+        s.camera.as_ref().unwrap(),
+    );
 }
 
 #[test]
@@ -97,7 +101,11 @@ fn a_constant_grid_on_a_sphere_carrier_is_a_larger_sphere() {
         "Freeform(shape: Surface(base: Sphere(radius: 1.5), transform: (translate: (0.2, -0.1, 0.3))))",
     )
     .unwrap();
-    same_picture(&field, &Field::compile(&sphere.shape).unwrap(), s.camera.as_ref().unwrap());
+    same_picture(
+        &field,
+        &Field::compile(&sphere.shape).unwrap(),
+        s.camera.as_ref().unwrap(),
+    );
 }
 
 /// The multilevel caster on the textured field and on the equivalent quadric: the same hit
@@ -119,7 +127,11 @@ fn same_picture(textured: &Field, quadric: &Field, camera: &FreeformCamera) {
             _ => differ += 1,
         }
     }
-    assert!(differ * 1000 <= a.len(), "{differ} of {} pixels differ", a.len());
+    assert!(
+        differ * 1000 <= a.len(),
+        "{differ} of {} pixels differ",
+        a.len()
+    );
 }
 
 fn random_texture(carrier: &str, w: usize, h: usize, seed: &[f64]) -> Texture {

@@ -231,7 +231,16 @@ fn a_search_split_into_rounds_returns_what_one_search_returns() {
     let prune = camera_outside(&field, &view, Bound::Affine);
     let twin = cast32(&gf, &v32, params.top_level, params.refine, prune);
     let out = caster
-        .cast_levels(&gpu, &gf, &v32, params.top_level, params.refine, prune, true)
+        .cast_levels(
+            &gpu,
+            &gf,
+            &v32,
+            params.top_level,
+            params.refine,
+            prune,
+            None,
+            true,
+        )
         .unwrap();
     let (f64_hits, _) = cast(&field, &view, &params);
     let a = agreement(&twin, &out.hits, &f64_hits);

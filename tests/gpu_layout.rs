@@ -64,6 +64,7 @@ fn shared_structs() -> Vec<Shared> {
     use relume::freeform::twin::{GpuBump, GpuLeaf};
     use relume::gpu::compressed_gather::Params as GatherParams;
     use relume::gpu::freeform_caster::FrameU as FreeformFrame;
+    use relume::gpu::freeform_shader::ShadeFrameU;
     use relume::gpu::mesh_renderer::FrameUniform;
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
     vec![
@@ -108,6 +109,15 @@ fn shared_structs() -> Vec<Shared> {
             "depth": field!(FreeformFrame, depth),
             "size": field!(FreeformFrame, size),
             "level": field!(FreeformFrame, level),
+            "sun": field!(FreeformFrame, sun),
+        }),
+        shared!("freeform_shade.wgsl", "ShadeFrame", ShadeFrameU {
+            "forward": field!(ShadeFrameU, forward),
+            "right": field!(ShadeFrameU, right),
+            "up": field!(ShadeFrameU, up),
+            "sun": field!(ShadeFrameU, sun),
+            "background": field!(ShadeFrameU, background),
+            "size": field!(ShadeFrameU, size),
         }),
         shared!("freeform.wgsl", "Leaf", GpuLeaf {
             "base": field!(GpuLeaf, base),

@@ -7,9 +7,9 @@
 //! coefficients about a point near the interval of interest (not about the ray origin) keeps
 //! them accurate far from the origin.
 
+use super::texture::Texture;
 use crate::error::{Error, Result};
 use crate::scene::freeform::{Quadric, Shape, Transform};
-use super::texture::Texture;
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
 /// `pᵀ A p + 2 bᵀ p + c`.

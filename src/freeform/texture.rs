@@ -418,7 +418,12 @@ impl Texture {
                     } else {
                         let mid = (0.5 * (lo[2] + hi[2])).atan2(0.5 * (lo[0] + hi[0]));
                         let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
-                        for (x, z) in [(lo[0], lo[2]), (lo[0], hi[2]), (hi[0], lo[2]), (hi[0], hi[2])] {
+                        for (x, z) in [
+                            (lo[0], lo[2]),
+                            (lo[0], hi[2]),
+                            (hi[0], lo[2]),
+                            (hi[0], hi[2]),
+                        ] {
                             let d = (z.atan2(x) - mid + PI).rem_euclid(2.0 * PI) - PI;
                             a = a.min(d);
                             b = b.max(d);
@@ -426,9 +431,18 @@ impl Texture {
                         let k = self.width as f64 / (2.0 * PI);
                         ((mid + a + PI) * k - 0.5, (mid + b + PI) * k - 0.5)
                     };
-                    let smax = if hi[1] > 0.0 { hi[1] / dmin } else { hi[1] / dmax };
-                    let smin = if lo[1] < 0.0 { lo[1] / dmin } else { lo[1] / dmax };
-                    let (lat_hi, lat_lo) = (smax.clamp(-1.0, 1.0).asin(), smin.clamp(-1.0, 1.0).asin());
+                    let smax = if hi[1] > 0.0 {
+                        hi[1] / dmin
+                    } else {
+                        hi[1] / dmax
+                    };
+                    let smin = if lo[1] < 0.0 {
+                        lo[1] / dmin
+                    } else {
+                        lo[1] / dmax
+                    };
+                    let (lat_hi, lat_lo) =
+                        (smax.clamp(-1.0, 1.0).asin(), smin.clamp(-1.0, 1.0).asin());
                     let k = self.height as f64 / PI;
                     let ys = ((0.5 * PI - lat_hi) * k - 0.5, (0.5 * PI - lat_lo) * k - 0.5);
                     let grad = if axis > 0.0 {

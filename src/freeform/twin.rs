@@ -306,9 +306,8 @@ pub fn quad_aff32(q: &GpuQuad, cell: &Cell32) -> Aff32 {
     let mut e = total - 0.5 * sum8_abs(d);
     let ext = cell.extent();
     let x: [f32; 3] = std::array::from_fn(|k| cell.c[k].abs() + ext[k]);
-    let ax3: [f32; 3] = std::array::from_fn(|i| {
-        a[i][0].abs() * x[0] + a[i][1].abs() * x[1] + a[i][2].abs() * x[2]
-    });
+    let ax3: [f32; 3] =
+        std::array::from_fn(|i| a[i][0].abs() * x[0] + a[i][1].abs() * x[1] + a[i][2].abs() * x[2]);
     let m = c0.abs()
         + 2.0 * (b[0].abs() * x[0] + b[1].abs() * x[1] + b[2].abs() * x[2])
         + (x[0] * ax3[0] + x[1] * ax3[1] + x[2] * ax3[2]);

@@ -237,7 +237,11 @@ pub fn line32_resume(
         let mut next = true;
         if !(lo <= 0.0 && hi >= 0.0) {
             if any_solid && hi < 0.0 {
-                return Search32 { t: tc, done: true, ..st };
+                return Search32 {
+                    t: tc,
+                    done: true,
+                    ..st
+                };
             }
         } else if s1 - s0 > min_cell && st.d < MAX_DEPTH {
             st.d += 1;
@@ -251,7 +255,11 @@ pub fn line32_resume(
             }
             if any_solid || fa <= 0.0 {
                 let t = if fa <= 0.0 { t0 } else { tc };
-                return Search32 { t, done: true, ..st };
+                return Search32 {
+                    t,
+                    done: true,
+                    ..st
+                };
             }
             if st.candidate < 0.0 {
                 st.candidate = tc;
@@ -364,8 +372,7 @@ pub fn cast32(
             if r[0] > r[1] {
                 return None;
             }
-            let (x, y) = (v.screen_x(px as f32 + 0.5), v.screen_y(py as f32 + 0.5));
-            let d: [f32; 3] = std::array::from_fn(|k| v.forward[k] + x * v.right[k] + y * v.up[k]);
+            let d = pixel_dir32(v, px as u32, py as u32);
             let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             let z = line32(f, [0.0; 3], d, r, min_cell, false)?;
             // The normal pass starts again from the stored distance, as the kernel's does.
@@ -378,4 +385,36 @@ pub fn cast32(
             Some((t, n))
         })
         .collect()
+}
+
+/// The kernel's `shadow` pass for one hit pixel: from the hit at distance `t` along the unit
+/// ray (`d` the pixel's ray, not unit) with normal `n`, is the sun toward `l` blocked? Pixels
+/// facing away from the sun are not searched (false).
+#[allow(clippy::too_many_arguments)]
+pub fn shadow32(
+    f: &GpuField,
+    v: &View32,
+    d: [f32; 3],
+    t: f32,
+    n: [f32; 3],
+    l: [f32; 3],
+    scale: f32,
+    refine: u32,
+) -> bool {
+    if n[0] * l[0] + n[1] * l[1] + n[2] * l[2] <= 0.0 {
+        return false;
+    }
+    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let p = d.map(|c| c * (t / len));
+    let eps = 1e-5 * t.max(scale * 1e-3);
+    let o: [f32; 3] = std::array::from_fn(|k| p[k] + eps * n[k]);
+    let far = exp32(v.far_ln).max(t) * 2.0;
+    let min_cell = v.theta / (1u32 << refine) as f32;
+    line32(f, o, l, [eps.ln(), far.ln()], min_cell, true).is_some()
+}
+
+/// The ray through pixel (px, py) as the kernel's `pixel_dir` builds it (not unit).
+pub fn pixel_dir32(v: &View32, px: u32, py: u32) -> [f32; 3] {
+    let (x, y) = (v.screen_x(px as f32 + 0.5), v.screen_y(py as f32 + 0.5));
+    std::array::from_fn(|k| v.forward[k] + x * v.right[k] + y * v.up[k])
 }

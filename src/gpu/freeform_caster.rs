@@ -1,6 +1,14 @@
-//! The freeform caster on wgpu: one `tile` dispatch per level of the screen quadtree, coarse to
-//! fine, each reading its parent level's depth ranges, then one `pixel` dispatch
-//! (`shaders/freeform.wgsl`; CPU twin `freeform::twin_cast::cast32`).
+//! The freeform caster on wgpu (`shaders/freeform.wgsl`; CPU twin `freeform::twin_cast`):
+//! per level of the screen quadtree, coarse to fine, `tile` passes that each walk a bounded
+//! number of depth cells; then rounds of the resumable per-pixel search (`pixel`) until no
+//! pixel is left; `normals`; and, for shadows, rounds of the same search toward the sun
+//! (`shadow`).
+//!
+//! Why passes and rounds: Mesa's lavapipe ends every loop of a shader invocation once the
+//! invocation has run 65,535 loop iterations in all (gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`),
+//! silently — at 256 perturbations and 640×480 a one-dispatch caster returned no hits at all.
+//! Each pass or round here stays within three quarters of that; on a GPU the same split keeps a
+//! frame's dispatches short for the driver's watchdog.
 
 use super::compute;
 use super::readback::read_buffer;
@@ -12,16 +20,16 @@ use crate::freeform::twin_cast::REFINE_STEPS;
 /// Loop iterations after which Mesa's lavapipe ends all loops of a shader invocation
 /// (gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`, Mesa 22.3, counted over every loop together).
 pub const LAVAPIPE_LOOPS: u32 = 65_535;
-/// Loop iterations one tile pass may spend: three quarters of lavapipe's limit.
+/// Loop iterations one tile pass or search round may spend: three quarters of that limit.
 const PASS_LOOPS: u32 = 49_152;
 /// The most loop iterations per field evaluation on a CPU adapter: one search step and the 26
 /// evaluations of a root's refinement must fit in lavapipe's limit.
 pub const MAX_CPU_ADAPTER_COST: u32 = LAVAPIPE_LOOPS / (REFINE_STEPS as u32 + 4);
-/// Pixel rounds between two reads of the unfinished count, and the most rounds of a frame.
+/// Search rounds between two reads of the unfinished count, and the most rounds of a search.
 const ROUNDS_PER_CHECK: u32 = 2;
 const MAX_ROUNDS: u32 = 256;
 
-/// The kernel's `Frame` uniform (one per level).
+/// The kernel's `Frame` uniform (one per pass).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FrameU {
@@ -31,6 +39,7 @@ pub struct FrameU {
     pub depth: [f32; 4],
     pub size: [u32; 4],
     pub level: [u32; 4],
+    pub sun: [f32; 4],
 }
 
 /// Compiled kernels of the freeform caster.
@@ -38,32 +47,64 @@ pub struct FreeformCaster {
     tile: wgpu::ComputePipeline,
     pixel: wgpu::ComputePipeline,
     normals: wgpu::ComputePipeline,
+    shadow: wgpu::ComputePipeline,
     pass_loops: u32,
 }
 
-/// One cast: per pixel `[t, nx, ny, nz]` (t < 0 where the ray misses), each tile level's depth
-/// ranges when asked for, and how the work was split.
+/// The sun for the shadow pass: unit direction toward it and the scene's scale (the shadow
+/// ray leaves the surface by `1e-5·max(t, scale·1e-3)`, as the CPU caster's does).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowSun {
+    pub direction: [f32; 3],
+    pub scale: f32,
+}
+
+/// A cast left on the GPU: per pixel `[t, nx, ny, nz]` in `hits` (t < 0: miss) and
+/// `(status, shadowed, leaf, 0)` in `state`; the tile levels' range buffers; how the work was
+/// split.
+pub struct GpuCast {
+    pub hits: wgpu::Buffer,
+    pub state: wgpu::Buffer,
+    pub leaves: wgpu::Buffer,
+    levels: Vec<wgpu::Buffer>,
+    pub tile_passes: u32,
+    pub pixel_rounds: u32,
+    pub shadow_rounds: u32,
+}
+
+/// A cast read back.
 pub struct Cast {
     pub hits: Vec<[f32; 4]>,
-    /// Coarse to fine, as [`crate::freeform::twin_cast::levels32`] returns them.
+    /// Coarse to fine, as [`crate::freeform::twin_cast::levels32`] returns them (when asked).
     pub levels: Vec<Vec<[f32; 2]>>,
-    /// Tile passes recorded, over all levels.
+    /// Per pixel (status, shadowed, leaf, 0); shadowed is 0 without a shadow pass.
+    pub state: Vec<[f32; 4]>,
     pub tile_passes: u32,
-    /// Rounds of the pixel search until no pixel was left.
     pub pixel_rounds: u32,
+    pub shadow_rounds: u32,
+}
+
+fn vec4s(bytes: &[u8]) -> Vec<[f32; 4]> {
+    let floats: &[f32] = bytemuck::cast_slice(bytes);
+    floats
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect()
 }
 
 impl FreeformCaster {
     pub fn new(gpu: &Gpu) -> Result<FreeformCaster> {
+        let p = |entry| compute::pipeline(gpu, "freeform.wgsl", entry);
         Ok(FreeformCaster {
-            tile: compute::pipeline(gpu, "freeform.wgsl", "tile")?,
-            pixel: compute::pipeline(gpu, "freeform.wgsl", "pixel")?,
-            normals: compute::pipeline(gpu, "freeform.wgsl", "normals")?,
+            tile: p("tile")?,
+            pixel: p("pixel")?,
+            normals: p("normals")?,
+            shadow: p("shadow")?,
             pass_loops: PASS_LOOPS,
         })
     }
 
-    /// The same caster with `loops` loop iterations per tile pass and pixel round (default
+    /// The same caster with `loops` loop iterations per tile pass and search round (default
     /// 49,152): smaller budgets split the work into more passes and rounds (tests use it to
     /// check that a search resumed across rounds finds what one uninterrupted search finds).
     pub fn with_pass_loops(mut self, loops: u32) -> FreeformCaster {
@@ -71,8 +112,7 @@ impl FreeformCaster {
         self
     }
 
-    /// Cast every pixel: per pixel `[t, nx, ny, nz]`, t < 0 where the ray misses. All levels are
-    /// recorded in one command buffer and submitted once.
+    /// Cast every pixel: per pixel `[t, nx, ny, nz]`, t < 0 where the ray misses.
     pub fn cast(
         &self,
         gpu: &Gpu,
@@ -82,13 +122,11 @@ impl FreeformCaster {
         refine: u32,
         prune: bool,
     ) -> Result<Vec<[f32; 4]>> {
-        Ok(self
-            .cast_levels(gpu, field, view, top_level, refine, prune, false)?
-            .hits)
+        let run = self.run(gpu, field, view, top_level, refine, prune, None)?;
+        Ok(self.read(gpu, &run, view, false)?.hits)
     }
 
-    /// [`Self::cast`], and with `levels` each tile level's depth ranges (coarse to fine, as
-    /// [`crate::freeform::twin_cast::levels32`] returns them) read back too.
+    /// [`Self::run`] and everything read back (the tile levels' ranges with `levels`).
     #[allow(clippy::too_many_arguments)]
     pub fn cast_levels(
         &self,
@@ -98,8 +136,49 @@ impl FreeformCaster {
         top_level: u32,
         refine: u32,
         prune: bool,
+        sun: Option<ShadowSun>,
         levels: bool,
     ) -> Result<Cast> {
+        let run = self.run(gpu, field, view, top_level, refine, prune, sun)?;
+        self.read(gpu, &run, view, levels)
+    }
+
+    /// Read a cast back (the tile levels' ranges too with `levels`).
+    pub fn read(&self, gpu: &Gpu, run: &GpuCast, view: &View32, levels: bool) -> Result<Cast> {
+        let n = (view.width * view.height) as usize;
+        let mut ranges = Vec::new();
+        if levels {
+            for buffer in &run.levels {
+                let v = vec4s(&read_buffer(gpu, buffer)?);
+                ranges.push(v.iter().map(|c| [c[0], c[1]]).collect());
+            }
+        }
+        let mut hits = vec4s(&read_buffer(gpu, &run.hits)?);
+        let mut state = vec4s(&read_buffer(gpu, &run.state)?);
+        hits.truncate(n);
+        state.truncate(n);
+        Ok(Cast {
+            hits,
+            levels: ranges,
+            state,
+            tile_passes: run.tile_passes,
+            pixel_rounds: run.pixel_rounds,
+            shadow_rounds: run.shadow_rounds,
+        })
+    }
+
+    /// Run the whole cast (and the shadow search toward `sun`), leaving the results on the GPU.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        field: &GpuField,
+        view: &View32,
+        top_level: u32,
+        refine: u32,
+        prune: bool,
+        sun: Option<ShadowSun>,
+    ) -> Result<GpuCast> {
         let (w, h) = (view.width, view.height);
         let per_cell = field.evaluation_loops() + 1;
         let cpu_adapter = gpu.info.device_type == format!("{:?}", wgpu::DeviceType::Cpu);
@@ -111,7 +190,6 @@ impl FreeformCaster {
             )));
         }
         let cells_per_pass = (self.pass_loops / per_cell).max(1);
-        let mut tile_passes = 0;
         let leaves = compute::storage(gpu, "freeform leaves", &field.leaves);
         // A binding holds at least one element; a scene without bumps never reads it.
         let one = [crate::freeform::twin::GpuBump::default()];
@@ -125,7 +203,13 @@ impl FreeformCaster {
             },
         );
         let ops = compute::storage(gpu, "freeform ops", &field.ops);
-        let hits = compute::output(gpu, "freeform hits", w as u64 * h as u64 * 16);
+        let pixels = w as u64 * h as u64;
+        let hits = compute::output(gpu, "freeform hits", pixels * 16);
+        let state = compute::output(gpu, "freeform shading state", pixels * 16);
+        let search = compute::output(gpu, "freeform search", pixels * 16);
+        let sun_u = sun.map_or([0.0; 4], |s| {
+            [s.direction[0], s.direction[1], s.direction[2], s.scale]
+        });
         let base = FrameU {
             forward: [
                 view.forward[0],
@@ -143,16 +227,38 @@ impl FreeformCaster {
             ],
             size: [w, h, field.ops.len() as u32, u32::from(prune)],
             level: [0; 4],
+            sun: sun_u,
         };
+        let bind = |pipeline: &wgpu::ComputePipeline,
+                    ub: &wgpu::Buffer,
+                    parent: &wgpu::Buffer,
+                    out: &wgpu::Buffer,
+                    searching: bool,
+                    counts: Option<&wgpu::Buffer>| {
+            let mut r = vec![
+                ub.as_entire_binding(),
+                leaves.as_entire_binding(),
+                bumps.as_entire_binding(),
+                ops.as_entire_binding(),
+                parent.as_entire_binding(),
+                out.as_entire_binding(),
+                hits.as_entire_binding(),
+            ];
+            if searching {
+                r.push(search.as_entire_binding());
+                r.push(counts.expect("a search counts").as_entire_binding());
+            }
+            compute::bind(gpu, pipeline, &r)
+        };
+        let groups = (w.div_ceil(8), h.div_ceil(8));
         let mut parent = compute::storage(
             gpu,
             "freeform root range",
             &[[view.near_ln, view.far_ln, 0.0, 2.0]],
         );
-        let mut parent_cols = 1u32;
-        let mut is_top = 1u32;
+        let mut levels = Vec::new();
+        let (mut parent_cols, mut is_top, mut tile_passes) = (1u32, 1u32, 0u32);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        let mut keep = Vec::new();
         for level in (1..=top_level).rev() {
             let size = 1u32 << level;
             let (cols, rows) = (w.div_ceil(size), h.div_ceil(size));
@@ -161,20 +267,9 @@ impl FreeformCaster {
             let ub = compute::uniform(gpu, "freeform level", &u);
             let out = compute::output(gpu, "freeform ranges", cols as u64 * rows as u64 * 16);
             // The longest walk a tile can have: the whole depth range at this level's cells.
-            let cells = ((view.far_ln - view.near_ln) / (view.theta * size as f32)).ceil() as u32 + 2;
-            let group = compute::bind(
-                gpu,
-                &self.tile,
-                &[
-                    ub.as_entire_binding(),
-                    leaves.as_entire_binding(),
-                    bumps.as_entire_binding(),
-                    ops.as_entire_binding(),
-                    parent.as_entire_binding(),
-                    out.as_entire_binding(),
-                    hits.as_entire_binding(),
-                ],
-            );
+            let cells =
+                ((view.far_ln - view.near_ln) / (view.theta * size as f32)).ceil() as u32 + 2;
+            let group = bind(&self.tile, &ub, &parent, &out, false, None);
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
                 pass.set_pipeline(&self.tile);
@@ -184,98 +279,75 @@ impl FreeformCaster {
                     tile_passes += 1;
                 }
             }
-            keep.push((ub, std::mem::replace(&mut parent, out)));
+            levels.push(out.clone());
+            parent = out;
             parent_cols = cols;
             is_top = 0;
         }
         gpu.queue.submit([enc.finish()]);
-        // The pixel search, in rounds of at most `steps` steps per pixel, leaving room in
-        // lavapipe's loop budget for the refinement of a sign change.
+        // Search rounds of at most `steps` steps per pixel, leaving room in lavapipe's loop
+        // budget for the refinement of a sign change.
         let steps = (self.pass_loops / per_cell)
             .saturating_sub(REFINE_STEPS as u32 + 2)
             .max(1);
-        let search = compute::output(gpu, "freeform search", w as u64 * h as u64 * 16);
-        let unfinished = compute::output(gpu, "freeform unfinished", MAX_ROUNDS as u64 * 4);
-        let scratch = compute::output(gpu, "freeform unused", 16);
-        let resources = |ub: &wgpu::Buffer, pixel: bool| {
-            let mut r = vec![
-                ub.as_entire_binding(),
-                leaves.as_entire_binding(),
-                bumps.as_entire_binding(),
-                ops.as_entire_binding(),
-                parent.as_entire_binding(),
-                scratch.as_entire_binding(),
-                hits.as_entire_binding(),
-            ];
-            if pixel {
-                r.extend([search.as_entire_binding(), unfinished.as_entire_binding()]);
-            }
-            compute::bind(gpu, if pixel { &self.pixel } else { &self.normals }, &r)
-        };
         let frame = |round: u32| {
             let mut u = base;
             u.depth[3] = steps as f32;
             u.level = [1, round, parent_cols, is_top];
             compute::uniform(gpu, "freeform pixel", &u)
         };
-        let mut round = 0;
-        let needed = loop {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            for _ in 0..ROUNDS_PER_CHECK {
-                let ub = frame(round);
-                let group = resources(&ub, true);
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&self.pixel);
-                pass.set_bind_group(0, &group, &[]);
-                pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-                round += 1;
-            }
-            gpu.queue.submit([enc.finish()]);
-            let counts = read_buffer(gpu, &unfinished)?;
-            let counts: &[u32] = bytemuck::cast_slice(&counts);
-            if let Some(r) = counts[..round as usize].iter().position(|&c| c == 0) {
-                break r as u32 + 1;
-            }
-            if round + ROUNDS_PER_CHECK > MAX_ROUNDS {
-                return Err(Error::limit(format!(
-                    "the freeform pixel search had {} pixels unfinished after {round} rounds of {steps} steps",
-                    counts[round as usize - 1]
-                )));
+        let rounds = |pipeline: &wgpu::ComputePipeline, what: &str| -> Result<u32> {
+            let counts = compute::output(gpu, "freeform unfinished", MAX_ROUNDS as u64 * 4);
+            let mut round = 0;
+            loop {
+                let mut enc = gpu.device.create_command_encoder(&Default::default());
+                for _ in 0..ROUNDS_PER_CHECK {
+                    let ub = frame(round);
+                    let group = bind(pipeline, &ub, &parent, &state, true, Some(&counts));
+                    let mut pass = enc.begin_compute_pass(&Default::default());
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &group, &[]);
+                    pass.dispatch_workgroups(groups.0, groups.1, 1);
+                    round += 1;
+                }
+                gpu.queue.submit([enc.finish()]);
+                let bytes = read_buffer(gpu, &counts)?;
+                let c: &[u32] = bytemuck::cast_slice(&bytes);
+                if let Some(r) = c[..round as usize].iter().position(|&c| c == 0) {
+                    return Ok(r as u32 + 1);
+                }
+                if round + ROUNDS_PER_CHECK > MAX_ROUNDS {
+                    return Err(Error::limit(format!(
+                        "the freeform {what} search had {} pixels unfinished after {round} rounds of {steps} steps",
+                        c[round as usize - 1]
+                    )));
+                }
             }
         };
-        let ub = frame(round);
-        let group = resources(&ub, false);
+        let pixel_rounds = rounds(&self.pixel, "pixel")?;
+        let ub = frame(0);
+        let group = bind(&self.normals, &ub, &parent, &state, false, None);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_pipeline(&self.normals);
             pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+            pass.dispatch_workgroups(groups.0, groups.1, 1);
         }
         gpu.queue.submit([enc.finish()]);
+        let shadow_rounds = match sun {
+            Some(_) => rounds(&self.shadow, "shadow")?,
+            None => 0,
+        };
         gpu.wait();
-        let mut ranges = Vec::new();
-        if levels {
-            keep.push((ub, parent));
-            for (_, buffer) in keep.iter().skip(1) {
-                let bytes = read_buffer(gpu, buffer)?;
-                let floats: &[f32] = bytemuck::cast_slice(&bytes);
-                ranges.push(floats.chunks_exact(4).map(|c| [c[0], c[1]]).collect());
-            }
-        }
-        drop(keep);
-        let bytes = read_buffer(gpu, &hits)?;
-        let floats: &[f32] = bytemuck::cast_slice(&bytes);
-        let hits = floats
-            .chunks_exact(4)
-            .take((w * h) as usize)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
-        Ok(Cast {
+        Ok(GpuCast {
             hits,
-            levels: ranges,
+            state,
+            leaves,
+            levels,
             tile_passes,
-            pixel_rounds: needed,
+            pixel_rounds,
+            shadow_rounds,
         })
     }
 }

@@ -9,6 +9,7 @@ pub mod blit;
 pub mod compressed_gather;
 pub mod compute;
 pub mod freeform_caster;
+pub mod freeform_shader;
 pub mod mesh_renderer;
 pub mod radiosity_runtime;
 pub mod readback;
@@ -179,6 +180,7 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "corner_interpolate.wgsl",
     "direct_light.wgsl",
     "freeform.wgsl",
+    "freeform_shade.wgsl",
     "gather_compressed.wgsl",
     "gather_dense.wgsl",
     "lighting.wgsl",

@@ -24,6 +24,15 @@ pub struct RenderTarget {
 impl RenderTarget {
     /// A target of at least 1×1 pixels.
     pub fn new(gpu: &Gpu, width: u32, height: u32) -> Self {
+        Self::with_usage(gpu, width, height, wgpu::TextureUsages::empty())
+    }
+
+    /// A target compute kernels can also write (`texture_storage_2d<rgba8unorm, write>`).
+    pub fn new_storage(gpu: &Gpu, width: u32, height: u32) -> Self {
+        Self::with_usage(gpu, width, height, wgpu::TextureUsages::STORAGE_BINDING)
+    }
+
+    fn with_usage(gpu: &Gpu, width: u32, height: u32, extra: wgpu::TextureUsages) -> Self {
         let (width, height) = (width.max(1), height.max(1));
         let size = wgpu::Extent3d {
             width,
@@ -47,7 +56,8 @@ impl RenderTarget {
             TARGET_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING,
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | extra,
         );
         let depth = texture(
             "depth",

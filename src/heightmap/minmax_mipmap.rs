@@ -153,7 +153,8 @@ impl MinMaxMipmap {
     /// clamped to the map): the max/min of at most 2×2 texels of the finest level whose blocks
     /// cover the rectangle in two per axis. Conservative, never tighter than the samples' range.
     pub fn sample_range(&self, xs: (usize, usize), ys: (usize, usize)) -> (f32, f32) {
-        let clamp = |r: (usize, usize), n: usize| (r.0.min(n - 1), r.1.min(n - 1).max(r.0.min(n - 1)));
+        let clamp =
+            |r: (usize, usize), n: usize| (r.0.min(n - 1), r.1.min(n - 1).max(r.0.min(n - 1)));
         let (x0, x1) = clamp(xs, self.map_width);
         let (y0, y1) = clamp(ys, self.map_height);
         for (l, level) in self.levels.iter().enumerate() {

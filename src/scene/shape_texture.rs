@@ -77,7 +77,9 @@ impl HeightGrid {
                 values,
             } => {
                 if *width < 2 || *height < 2 {
-                    return Err(format!("a height grid needs at least 2x2 samples, got {width}x{height}"));
+                    return Err(format!(
+                        "a height grid needs at least 2x2 samples, got {width}x{height}"
+                    ));
                 }
                 if values.len() != width * height {
                     return Err(format!(
@@ -156,7 +158,10 @@ impl TexturedSurface {
             }
         }
         if !(self.height_scale.is_finite() && self.height_scale != 0.0) {
-            return Err(format!("height_scale must be finite and non-zero, got {}", self.height_scale));
+            return Err(format!(
+                "height_scale must be finite and non-zero, got {}",
+                self.height_scale
+            ));
         }
         if self.lod > 12 {
             return Err(format!("lod must be at most 12, got {}", self.lod));
@@ -170,4 +175,3 @@ impl TexturedSurface {
         Ok(())
     }
 }
-
