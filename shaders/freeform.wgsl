@@ -577,7 +577,10 @@ fn shadow(@builtin(global_invocation_id) id: vec3<u32>) {
     let len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
     let t = hit.x;
     let p = d * (t / len);
-    let eps = 1e-5 * max(t, frame.sun.w * 1e-3);
+    // Lifted off the surface by half a pixel's footprint (at least the CPU caster's
+    // 1e-5·max(t, scale·1e-3)): an f32 hit lies up to ~1e-4·t below the surface, and a ray
+    // started there would find the solid it starts in.
+    let eps = max(1e-5 * max(t, frame.sun.w * 1e-3), 0.5 * frame.up.w * t);
     let o = p + eps * n;
     let far = max(exp32(frame.depth.y), t) * 2.0;
     let range = vec2<f32>(log(eps), log(far));

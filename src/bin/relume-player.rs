@@ -25,7 +25,8 @@ fn after_help() -> String {
 #[derive(Parser)]
 #[command(name = "relume-player", version, about = "Render baked relume scenes and terrain with wgpu", after_help = after_help())]
 struct Cli {
-    /// Baked directory (from `relume-bake run`)
+    /// Baked directory (from `relume-bake run`), or a freeform scene (`scenes/freeform/*.ron`)
+    /// cast live
     baked_dir: PathBuf,
     /// Render without a window into --out
     #[arg(long)]

@@ -388,8 +388,9 @@ pub fn cast32(
 }
 
 /// The kernel's `shadow` pass for one hit pixel: from the hit at distance `t` along the unit
-/// ray (`d` the pixel's ray, not unit) with normal `n`, is the sun toward `l` blocked? Pixels
-/// facing away from the sun are not searched (false).
+/// ray (`d` the pixel's ray, not unit) with normal `n`, lifted off the surface by half a
+/// pixel's footprint, is the sun toward `l` blocked? Pixels facing away from the sun are not
+/// searched (false).
 #[allow(clippy::too_many_arguments)]
 pub fn shadow32(
     f: &GpuField,
@@ -406,7 +407,8 @@ pub fn shadow32(
     }
     let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     let p = d.map(|c| c * (t / len));
-    let eps = 1e-5 * t.max(scale * 1e-3);
+    // Half a pixel's footprint (the kernel's bias; see there).
+    let eps = (1e-5 * t.max(scale * 1e-3)).max(0.5 * v.theta * t);
     let o: [f32; 3] = std::array::from_fn(|k| p[k] + eps * n[k]);
     let far = exp32(v.far_ln).max(t) * 2.0;
     let min_cell = v.theta / (1u32 << refine) as f32;

@@ -1,12 +1,14 @@
 //! The runtime: load a baked directory and render frames with wgpu. The binary
 //! (`relume-player`) only parses arguments and runs the window or headless loop around this.
 
+mod freeform;
 pub mod headless;
 pub mod light_spec;
 mod mesh;
 mod terrain;
 pub mod window;
 
+pub use freeform::FreeformPlayer;
 pub use mesh::MeshPlayer;
 pub use terrain::TerrainPlayer;
 
@@ -47,6 +49,8 @@ pub struct PlayerOptions {
 pub enum Player {
     Mesh(Box<MeshPlayer>),
     Terrain(Box<TerrainPlayer>),
+    /// A freeform scene file (`.ron`), cast live: nothing baked.
+    Freeform(Box<FreeformPlayer>),
 }
 
 /// Wall and GPU times of one frame.
@@ -60,7 +64,8 @@ pub struct FrameTimes {
 }
 
 impl Player {
-    /// Load the bake at `dir` for a `width`×`height` target.
+    /// Load the bake at `dir` (or the freeform scene file `dir`, a `.ron`) for a
+    /// `width`×`height` target.
     pub fn load(
         gpu: &Gpu,
         dir: &Path,
@@ -68,6 +73,11 @@ impl Player {
         width: u32,
         height: u32,
     ) -> Result<Player> {
+        if dir.is_file() && dir.extension().is_some_and(|e| e == "ron") {
+            return Ok(Player::Freeform(Box::new(FreeformPlayer::load(
+                gpu, dir, width, height,
+            )?)));
+        }
         let manifest = Manifest::read(dir)?;
         match manifest.pipeline.input.kind() {
             "scene" => Ok(Player::Mesh(Box::new(MeshPlayer::load(
@@ -84,6 +94,7 @@ impl Player {
         match self {
             Player::Mesh(m) => m.default_camera(),
             Player::Terrain(t) => t.default_camera(),
+            Player::Freeform(f) => f.default_camera(),
         }
     }
 
@@ -98,6 +109,9 @@ impl Player {
             Player::Terrain(_) => Err(crate::error::Error::knob(
                 "punctual lights (--light) light mesh bakes; a height-map bake is lit by the sun (--sun)",
             )),
+            Player::Freeform(_) => Err(crate::error::Error::knob(
+                "punctual lights (--light) light mesh bakes; a freeform scene is lit by the sun (--sun)",
+            )),
         }
     }
 
@@ -106,6 +120,10 @@ impl Player {
         match self {
             Player::Mesh(m) => m.set_sun(gpu, sun),
             Player::Terrain(t) => t.set_sun(gpu, sun),
+            Player::Freeform(f) => {
+                f.set_sun(sun);
+                Ok(())
+            }
         }
     }
 
@@ -126,6 +144,7 @@ impl Player {
                 t.settings.fog = s.fog;
                 t.render(gpu, camera, timer)
             }
+            Player::Freeform(f) => f.render(gpu, camera, s, timer),
         }
     }
 
@@ -134,6 +153,7 @@ impl Player {
         match self {
             Player::Mesh(m) => &m.renderer.target.view,
             Player::Terrain(t) => &t.renderer.target.view,
+            Player::Freeform(f) => &f.target.view,
         }
     }
 
@@ -142,6 +162,7 @@ impl Player {
         match self {
             Player::Mesh(m) => m.renderer.resize(gpu, width, height),
             Player::Terrain(t) => t.renderer.resize(gpu, width, height),
+            Player::Freeform(f) => f.resize(gpu, width, height),
         }
         Ok(())
     }
@@ -151,6 +172,7 @@ impl Player {
         match self {
             Player::Mesh(m) => m.renderer.target.read_image(gpu),
             Player::Terrain(t) => t.renderer.target.read_image(gpu),
+            Player::Freeform(f) => f.target.read_image(gpu),
         }
     }
 }
