@@ -1,6 +1,6 @@
 // Shading of a freeform frame (after `freeform.wgsl` cast it): Lambert and Phong under the sun,
 // an ambient fraction, sun shadows from the shadow pass, the background where the ray missed,
-// exposure, sRGB. Rust twin: relume::freeform::twin_shade::shade32.
+// exposure, sRGB. Rust twin: relume::render::freeform_shade::shade32.
 
 struct ShadeFrame {
     forward: vec4<f32>,    // xyz, tan_x

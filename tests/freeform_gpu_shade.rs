@@ -1,6 +1,6 @@
 //! The freeform frame on the GPU (lavapipe here and in CI) against its CPU twins: the shadow
 //! pass's mask against `twin_cast::shadow32`, and the shaded RGBA8 frame against
-//! `twin_shade::shade32` of the twin's cast — what `relume-player scenes/freeform/X.ron` shows.
+//! `render::freeform_shade::shade32` of the twin's cast — what `relume-player scenes/freeform/X.ron` shows.
 
 mod common;
 
@@ -8,11 +8,11 @@ use relume::freeform::rmlrc::{camera_outside, RmlrcParams};
 use relume::freeform::shade::sun_direction;
 use relume::freeform::twin::{GpuField, View32};
 use relume::freeform::twin_cast::{cast32, eval32, pixel_dir32, shadow32};
-use relume::freeform::twin_shade::{shade32, Shading};
 use relume::freeform::{Bound, Field, View};
 use relume::gpu::freeform_caster::{FreeformCaster, ShadowSun};
 use relume::gpu::freeform_shader::FreeformShader;
 use relume::gpu::render_target::RenderTarget;
+use relume::render::freeform_shade::{shade32, Shading};
 use relume::scene::freeform::FreeformScene;
 use std::path::Path;
 

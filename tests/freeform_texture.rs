@@ -162,11 +162,11 @@ proptest! {
         let e = 10f64.powf(log_size);
         let lo = c.map(|v| v - e);
         let hi = c.map(|v| v + e);
-        let r = tex.range(lo, hi);
+        let (rlo, rhi) = tex.range(lo, hi);
         for s in samples {
             let p: [f64; 3] = std::array::from_fn(|k| lo[k] + s[k] * (hi[k] - lo[k]));
             let v = tex.value(p);
-            prop_assert!(r.lo <= v && v <= r.hi, "{v} outside [{}, {}] at {p:?}", r.lo, r.hi);
+            prop_assert!(rlo <= v && v <= rhi, "{v} outside [{rlo}, {rhi}] at {p:?}");
         }
     }
 

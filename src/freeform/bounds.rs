@@ -243,7 +243,8 @@ pub fn field_range(field: &Field, cell: &Cell, bound: Bound, work: &mut Work) ->
                 let l = &field.leaves[i];
                 if let Some(t) = l.texture {
                     work.terms += 1;
-                    return field.textures[t].range(lo, hi);
+                    let (lo, hi) = field.textures[t].range(lo, hi);
+                    return Range { lo, hi };
                 }
                 let mut r = quad_interval(&l.base, lo, hi);
                 work.terms += 1;
@@ -270,7 +271,8 @@ pub fn field_range(field: &Field, cell: &Cell, bound: Bound, work: &mut Work) ->
                 let l = &field.leaves[i];
                 if let Some(t) = l.texture {
                     work.terms += 1;
-                    return Affine::from_range(field.textures[t].range(lo, hi));
+                    let (lo, hi) = field.textures[t].range(lo, hi);
+                    return Affine::from_range(Range { lo, hi });
                 }
                 let mut r = quad_affine(&l.base, cell);
                 work.terms += 1;

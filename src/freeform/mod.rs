@@ -25,7 +25,6 @@ pub mod shade;
 pub mod texture;
 pub mod twin;
 pub mod twin_cast;
-pub mod twin_shade;
 pub mod view;
 
 pub use bounds::Bound;

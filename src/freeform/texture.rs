@@ -23,7 +23,6 @@
 //! files); the sphere's parameterisation is singular at its poles and centre, where the bounds
 //! fall back to the whole height range.
 
-use super::bounds::Range;
 use crate::error::{Error, Result};
 use crate::heightmap::minmax_mipmap::MinMaxMipmap;
 use crate::heightmap::HeightMap;
@@ -319,25 +318,19 @@ impl Texture {
         }
     }
 
-    /// A range containing F over the box [lo, hi] (both bounds of the module header).
-    pub fn range(&self, lo: [f64; 3], hi: [f64; 3]) -> Range {
+    /// (low, high) containing F over the box [lo, hi] (both bounds of the module header).
+    pub fn range(&self, lo: [f64; 3], hi: [f64; 3]) -> (f64, f64) {
         let c: [f64; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
         let e: [f64; 3] = std::array::from_fn(|k| 0.5 * (hi[k] - lo[k]));
         let (dl, dh, (xl, xh), (yl, yh), grad) = self.box_coords(c, e);
         let (hmax, hmin) = self.sample_range(xl, xh, yl, yh);
         // Rounding: a hair of slack relative to the magnitudes involved.
         let slack = 1e-12 * (norm(c) + norm(e) + hmax.abs().max(hmin.abs()) as f64 + 1.0);
-        let mip = Range {
-            lo: dl - hmax as f64 - slack,
-            hi: dh - hmin as f64 + slack,
-        };
+        let mip = (dl - hmax as f64 - slack, dh - hmin as f64 + slack);
         let r = norm(e);
         let l = 1.0 + grad;
         let f = self.value(c);
-        Range {
-            lo: mip.lo.max(f - l * r - slack),
-            hi: mip.hi.min(f + l * r + slack),
-        }
+        (mip.0.max(f - l * r - slack), mip.1.min(f + l * r + slack))
     }
 
     /// The largest and smallest sample over continuous sample coordinates [xl, xh] × [yl, yh]
@@ -487,11 +480,11 @@ impl Texture {
             let (pa, pb) = (at(a), at(b));
             let lo: [f64; 3] = std::array::from_fn(|k| pa[k].min(pb[k]));
             let hi: [f64; 3] = std::array::from_fn(|k| pa[k].max(pb[k]));
-            let r = self.range(lo, hi);
-            if r.lo > 0.0 {
+            let (rlo, rhi) = self.range(lo, hi);
+            if rlo > 0.0 {
                 continue;
             }
-            if r.hi < 0.0 {
+            if rhi < 0.0 {
                 push(a, b, &mut out);
                 continue;
             }

@@ -1,5 +1,5 @@
 //! Shading of a freeform cast on wgpu (`shaders/freeform_shade.wgsl`; CPU twin
-//! `freeform::twin_shade::shade32`): from the cast's hits and shadow state into an RGBA8
+//! `render::freeform_shade::shade32`): from the cast's hits and shadow state into an RGBA8
 //! storage target.
 
 use super::compute;
@@ -7,7 +7,7 @@ use super::freeform_caster::GpuCast;
 use super::Gpu;
 use crate::error::Result;
 use crate::freeform::twin::View32;
-use crate::freeform::twin_shade::Shading;
+use crate::render::freeform_shade::Shading;
 
 /// The kernel's `ShadeFrame` uniform.
 #[repr(C)]

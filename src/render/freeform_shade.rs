@@ -1,6 +1,6 @@
 //! The f32 twin of `shaders/freeform_shade.wgsl`: one pixel's colour from the cast (distance and
 //! normal), the shadow pass's answer and the surface's material — the CPU caster's shading
-//! (`super::shade`: Lambert and a Phong lobe of exponent 32 under the sun, an ambient fraction)
+//! (`crate::freeform::shade`: Lambert and a Phong lobe of exponent 32 under the sun, an ambient fraction)
 //! then exposure and sRGB, as the kernel computes it.
 
 use crate::render::tonemap::{linear_to_srgb, to_u8};
