@@ -86,6 +86,17 @@ docs-images: build
 	cp $(DOCS_OUT)/cornell-sun-frames/frame_0001.png docs/images/cornell-sun.png
 	cp $(DOCS_OUT)/gltf-room-frames/frame_0000.png docs/images/gltf-room.png
 	cp $(DOCS_OUT)/terrain-frames/frame_0000.png docs/images/puget-sound-player.png
+	for s in csg-holes terrain-16 blobs-128 planet; do \
+	    $(BAKE) -q freeform render scenes/freeform/$$s.ron --size 320x240 \
+	        --out docs/images/freeform-$$s.png || exit 1; \
+	done
+	for m in 0 1; do \
+	    $(BAKE) -q freeform render scenes/freeform/morph-grid.ron --size 320x240 --morph $$m \
+	        --out docs/images/freeform-morph-$$m.png || exit 1; \
+	done
+	$(PLAYER) scenes/freeform/csg-holes.ron --headless -q --size 320x240 --sun 200,35 \
+	    --out $(DOCS_OUT)/freeform-frames
+	cp $(DOCS_OUT)/freeform-frames/frame_0000.png docs/images/freeform-player.png
 	$(BAKE) -q study radiosity --out $(DOCS_OUT)/study/radiosity
 	$(BAKE) -q study compression --out $(DOCS_OUT)/study/compression
 	$(BAKE) -q study terrain --sizes 512,1024,2048 --elevations 5,30 --soft-elevations 2,5 \
