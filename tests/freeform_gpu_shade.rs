@@ -169,4 +169,47 @@ fn the_player_draws_what_the_cpu_renderer_draws() {
     // differ from the f64 caster's — mean 0.24/255. Bounds: 1 % and 1/255 (3x and 4x).
     assert!(off * 100 <= n, "{off} of {n} pixels differ");
     assert!(mean < 1.0, "mean difference {mean}/255");
+
+    // The window shows it too (under a virtual X server; make test installs xvfb).
+    if std::process::Command::new("xvfb-run")
+        .arg("--help")
+        .output()
+        .is_err()
+    {
+        common::missing("xvfb-run for the window test (apt-get install xvfb xauth)");
+        return;
+    }
+    let o = std::process::Command::new("xvfb-run")
+        .args(["-a", env!("CARGO_BIN_EXE_relume-player")])
+        .arg(&scene)
+        .args(["--size", "96x72", "--exit-after", "2", "--sun", "120,30"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "window: {}", common::text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("showed 2 frame(s) in a window"),
+        "{}",
+        common::text(&o)
+    );
+}
+
+/// What the GPU cannot evaluate is refused before a frame, naming the file.
+#[test]
+fn the_player_refuses_a_shape_texture_with_a_message() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
+        .arg(common::data("scenes/freeform/morph-grid.ron"))
+        .args(["--headless", "--size", "32x24", "--quiet", "--out"])
+        .arg(dir.path().join("f"))
+        .output()
+        .unwrap();
+    let err = common::expect_code(&o, 3);
+    assert!(
+        err.contains("morph-grid.ron") && err.contains("shape textures"),
+        "{err}"
+    );
+    assert!(!dir.path().join("f").exists(), "no partial output");
 }
