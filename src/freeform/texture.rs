@@ -350,7 +350,7 @@ impl Texture {
             return mip.sample_range(xs, ys);
         }
         let (x0, x1) = (xl.floor(), xh.ceil());
-        if !(x1 - x0 < (w - 1) as f64) {
+        if x1 - x0 >= (w - 1) as f64 || x1.is_nan() || x0.is_nan() {
             return mip.sample_range((0, w - 1), ys);
         }
         let a = x0.rem_euclid(w as f64) as usize;

@@ -109,8 +109,7 @@ impl FreeformPlayer {
         let v32 = View32::of(&view);
         let gf = GpuField::upload(&self.field, view.eye)?;
         let prune = camera_outside(&self.field, &view, Bound::Affine);
-        let l = sun_direction(self.sun.azimuth_deg as f64, self.sun.elevation_deg as f64)
-            .map(|v| v as f32);
+        let l = sun_direction(self.sun.azimuth_deg, self.sun.elevation_deg).map(|v| v as f32);
         let sun = s.shadows.then_some(ShadowSun {
             direction: l,
             scale: (view.far * view.near).sqrt() as f32,
