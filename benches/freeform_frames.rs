@@ -5,7 +5,8 @@
 //! against the reference in the same run. On Mesa's lavapipe the "GPU" time is a software
 //! rasteriser's CPU time.
 //!
-//! `cargo bench --bench freeform_frames [-- --all]`
+//! `cargo bench --bench freeform_frames [-- --all] [-- --cpu-only]` (`--cpu-only` skips the
+//! GPU: a 256-perturbation frame at 640x480 takes 20 minutes on lavapipe).
 
 use relume::freeform::rmlrc::{camera_outside, cast, RmlrcParams};
 use relume::freeform::shade::primary;
@@ -25,12 +26,13 @@ fn seconds(f: impl FnOnce()) -> f64 {
 
 fn main() {
     let all = std::env::args().any(|a| a == "--all");
+    let cpu_only = std::env::args().any(|a| a == "--cpu-only");
     let sizes: &[(u32, u32)] = if all {
         &[(640, 480), (1280, 720), (1920, 1080)]
     } else {
         &[(640, 480)]
     };
-    let gpu = Gpu::new(None).ok();
+    let gpu = if cpu_only { None } else { Gpu::new(None).ok() };
     let caster = gpu
         .as_ref()
         .map(|g| FreeformCaster::new(g).expect("kernel compiles"));
@@ -82,6 +84,7 @@ fn main() {
                     });
                     format!("{s:.3} ({:.2}), {gpu_hits} hits", s / reference)
                 }
+                _ if cpu_only => "not run (--cpu-only)".into(),
                 _ => "no adapter".into(),
             };
             println!(

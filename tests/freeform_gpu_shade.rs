@@ -171,26 +171,10 @@ fn the_player_draws_what_the_cpu_renderer_draws() {
     assert!(mean < 1.0, "mean difference {mean}/255");
 
     // The window shows it too (under a virtual X server; make test installs xvfb).
-    if std::process::Command::new("xvfb-run")
-        .arg("--help")
-        .output()
-        .is_err()
-    {
-        common::missing("xvfb-run for the window test (apt-get install xvfb xauth)");
-        return;
-    }
-    let o = std::process::Command::new("xvfb-run")
-        .args(["-a", env!("CARGO_BIN_EXE_relume-player")])
-        .arg(&scene)
-        .args(["--size", "96x72", "--exit-after", "2", "--sun", "120,30"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "window: {}", common::text(&o));
-    assert!(
-        String::from_utf8_lossy(&o.stderr).contains("showed 2 frame(s) in a window"),
-        "{}",
-        common::text(&o)
-    );
+    let args = ["--size", "96x72", "--sun", "120,30"].map(std::ffi::OsStr::new);
+    let mut all = vec![scene.as_os_str()];
+    all.extend(args);
+    common::player_in_window(&all, 2);
 }
 
 /// What the GPU cannot evaluate is refused before a frame, naming the file.

@@ -399,25 +399,10 @@ fn command_line_lights_light_the_scene_and_the_window_opens() {
     assert!(common::text(&o).contains("three comma-separated numbers"));
 
     // The window, under a virtual X server when there is one (make test installs xvfb).
-    let xvfb = std::process::Command::new("xvfb-run")
-        .arg("--help")
-        .output();
-    if xvfb.is_err() {
-        common::missing("xvfb-run for the window test (apt-get install xvfb xauth)");
-        return;
-    }
-    let o = std::process::Command::new("xvfb-run")
-        .args(["-a", env!("CARGO_BIN_EXE_relume-player")])
-        .arg(&dir)
-        .args(["--size", "160x120", "--exit-after", "3", "--sun", "20,30"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "window: {}", common::text(&o));
-    assert!(
-        String::from_utf8_lossy(&o.stderr).contains("showed 3 frame(s) in a window"),
-        "{}",
-        common::text(&o)
-    );
+    let args = ["--size", "160x120", "--sun", "20,30"].map(std::ffi::OsStr::new);
+    let mut all = vec![dir.as_os_str()];
+    all.extend(args);
+    common::player_in_window(&all, 3);
 }
 
 #[test]

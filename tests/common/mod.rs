@@ -144,3 +144,27 @@ pub fn require_python(modules: &[&str]) -> bool {
     ));
     false
 }
+
+/// Run `relume-player` in a window under a virtual X server (`xvfb-run -a`; `make test` installs
+/// xvfb) for `frames` frames and check that it showed them. `None` (after reporting it through
+/// [`missing`]) when there is no xvfb-run.
+pub fn player_in_window(args: &[&std::ffi::OsStr], frames: u32) -> Option<()> {
+    if Command::new("xvfb-run").arg("--help").output().is_err() {
+        missing("xvfb-run for the window test (apt-get install xvfb xauth)");
+        return None;
+    }
+    let o = Command::new("xvfb-run")
+        .args(["-a", env!("CARGO_BIN_EXE_relume-player")])
+        .args(args)
+        .args(["--exit-after", &frames.to_string()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "window: {}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr)
+            .contains(&format!("showed {frames} frame(s) in a window")),
+        "{}",
+        text(&o)
+    );
+    Some(())
+}
