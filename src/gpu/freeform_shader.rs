@@ -55,27 +55,17 @@ impl FreeformShader {
             size: [view.width, view.height, u32::from(s.shadows), 0],
         };
         let ub = compute::uniform(gpu, "freeform shade", &u);
-        let layout = self.pipeline.get_bind_group_layout(0);
-        let entries = [
-            ub.as_entire_binding(),
-            cast.leaves.as_entire_binding(),
-            cast.hits.as_entire_binding(),
-            cast.state.as_entire_binding(),
-            wgpu::BindingResource::TextureView(target),
-        ];
-        let entries: Vec<wgpu::BindGroupEntry> = entries
-            .into_iter()
-            .enumerate()
-            .map(|(i, resource)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource,
-            })
-            .collect();
-        let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("freeform shade"),
-            layout: &layout,
-            entries: &entries,
-        });
+        let group = compute::bind(
+            gpu,
+            &self.pipeline,
+            &[
+                ub.as_entire_binding(),
+                cast.leaves.as_entire_binding(),
+                cast.hits.as_entire_binding(),
+                cast.state.as_entire_binding(),
+                wgpu::BindingResource::TextureView(target),
+            ],
+        );
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
