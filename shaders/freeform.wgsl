@@ -2,7 +2,9 @@
 // `tile` dispatch per level (coarse to fine), then `pixel`. Rust twin, operation for operation:
 // relume::freeform::twin (bounds, widening) and relume::freeform::twin_cast (the passes).
 // The scene is eye-relative; every f32 bound is widened so that it contains the f64 bound
-// (see twin.rs for the argument).
+// (see twin.rs for the argument). Shape textures: freeform_texture.wgsl, records after the
+// program in `ops` (a textured leaf has range = (0, 0, 1, record offset after the program)).
+//! include freeform_texture.wgsl
 
 struct Quad { r0: vec4<f32>, r1: vec4<f32>, r2: vec4<f32> }
 struct Bump { q: Quad, lo_weight: vec4<f32>, hi_flag: vec4<f32> }
@@ -21,7 +23,8 @@ struct Frame {
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> leaves: array<Leaf>;
 @group(0) @binding(2) var<storage, read> bumps: array<Bump>;
-@group(0) @binding(3) var<storage, read> ops: array<u32>;
+// @group(0) @binding(3): `ops`, the CSG program then the shape-texture records, declared in
+// freeform_texture.wgsl (which is also compiled on its own).
 // Per tile: (log-depth lo, hi, next depth cell, state: 0 new, 1 walking, 2 done).
 @group(0) @binding(4) var<storage, read> parent_ranges: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> out_ranges: array<vec4<f32>>;
@@ -197,6 +200,11 @@ fn field_range(cell: Cell) -> vec2<f32> {
         let arg = op & 0xffffu;
         if (kind == 0u) {
             let leaf = leaves[arg];
+            if (leaf.range.z != 0u) {
+                let t = tex_range(frame.size.z + leaf.range.w, lo, hi);
+                stack[slot] = aff_hull(t.x, t.y);
+                continue;
+            }
             var r = quad_aff(leaf.base, cell);
             for (var i = leaf.range.x; i < leaf.range.x + leaf.range.y; i++) {
                 let b = bumps[i];
@@ -338,6 +346,7 @@ fn quad_grad(q: Quad, p: vec3<f32>) -> vec3<f32> {
 
 fn leaf_value(i: u32, p: vec3<f32>) -> f32 {
     let leaf = leaves[i];
+    if (leaf.range.z != 0u) { return tex_value(frame.size.z + leaf.range.w, p); }
     var v = quad_eval(leaf.base, p);
     for (var k = leaf.range.x; k < leaf.range.x + leaf.range.y; k++) {
         let q = quad_eval(bumps[k].q, p);
@@ -381,6 +390,7 @@ fn normal_at(p: vec3<f32>) -> vec3<f32> {
     let e = eval_point(p);
     let leaf = leaves[u32(e.y)];
     var g = quad_grad(leaf.base, p);
+    if (leaf.range.z != 0u) { g = tex_gradient(frame.size.z + leaf.range.w, p); }
     for (var k = leaf.range.x; k < leaf.range.x + leaf.range.y; k++) {
         let q = quad_eval(bumps[k].q, p);
         if (q > 0.0) { g += (3.0 * bumps[k].lo_weight.w * q * q) * quad_grad(bumps[k].q, p); }

@@ -109,48 +109,55 @@ fn gpu_shadows_and_shading_return_the_twins() {
     }
 }
 
-/// The real player, headless, on a freeform scene file against `relume-bake freeform render`
-/// (the f64 CPU multilevel caster and shading) of the same view and sun: two independent code
-/// paths, one picture.
-#[test]
-fn the_player_draws_what_the_cpu_renderer_draws() {
-    if common::gpu().is_none() {
-        return;
-    }
+/// `relume-bake freeform render` (the f64 CPU multilevel caster and shading) and the real
+/// player, headless, of one scene, view and sun; frame `frame` of `--frames frames` against the
+/// CPU render at `--morph morph`. Returns (pixels off by more than 8/255, pixels, mean / 255).
+fn player_vs_cpu(
+    scene: &str,
+    size: &str,
+    sun: Option<&str>,
+    frames: u32,
+    frame: u32,
+    morph: f64,
+) -> (usize, usize, f64) {
     let dir = tempfile::tempdir().unwrap();
-    let scene = common::data("scenes/freeform/csg-holes.ron");
+    let scene = common::data(scene);
     let cpu_png = dir.path().join("cpu.png");
-    let o = common::bake(
-        dir.path(),
-        &[
-            "freeform",
-            "render",
-            scene.to_str().unwrap(),
-            "--size",
-            "120x90",
-            "--sun",
-            "200,35",
-            "--out",
-            cpu_png.to_str().unwrap(),
-            "--quiet",
-        ],
-    );
+    let morph = morph.to_string();
+    let sun_args: Vec<&str> = sun.map_or(vec![], |s| vec!["--sun", s]);
+    let mut args = vec![
+        "freeform",
+        "render",
+        scene.to_str().unwrap(),
+        "--size",
+        size,
+    ];
+    args.extend(&sun_args);
+    args.extend([
+        "--morph",
+        &morph,
+        "--out",
+        cpu_png.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let o = common::bake(dir.path(), &args);
     common::expect_code(&o, 0);
-    let frames = dir.path().join("frames");
+    let out = dir.path().join("frames");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
-        .args([scene.to_str().unwrap(), "--headless", "--size", "120x90"])
+        .args([scene.to_str().unwrap(), "--headless", "--size", size])
+        .args(&sun_args)
         .args([
-            "--sun",
-            "200,35",
+            "--frames",
+            &frames.to_string(),
             "--quiet",
             "--out",
-            frames.to_str().unwrap(),
+            out.to_str().unwrap(),
         ])
         .output()
         .unwrap();
     common::expect_code(&o, 0);
     let a = image::open(&cpu_png).unwrap().to_rgba8();
-    let b = image::open(frames.join("frame_0000.png"))
+    let b = image::open(out.join(format!("frame_{frame:04}.png")))
         .unwrap()
         .to_rgba8();
     let (mut off, mut sum) = (0usize, 0u64);
@@ -162,7 +169,25 @@ fn the_player_draws_what_the_cpu_renderer_draws() {
     let n = (a.width() * a.height()) as usize;
     let mean = sum as f64 / n as f64;
     eprintln!(
-        "player vs CPU renderer: {off} of {n} pixels off by more than 8/255, mean {mean:.3}/255"
+        "{}: player frame {frame} vs CPU renderer (morph {morph}): {off} of {n} pixels off by more than 8/255, mean {mean:.3}/255",
+        scene.display()
+    );
+    (off, n, mean)
+}
+
+/// The real player against the CPU renderer: two independent code paths, one picture.
+#[test]
+fn the_player_draws_what_the_cpu_renderer_draws() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let (off, n, mean) = player_vs_cpu(
+        "scenes/freeform/csg-holes.ron",
+        "120x90",
+        Some("200,35"),
+        1,
+        0,
+        0.0,
     );
     // Measured (120x90, lavapipe): 36 of 10,800 pixels (0.33 %) off by more than 8/255 —
     // shadow edges and silhouettes, where the f32 cast and the GPU's half-pixel shadow bias
@@ -171,28 +196,81 @@ fn the_player_draws_what_the_cpu_renderer_draws() {
     assert!(mean < 1.0, "mean difference {mean}/255");
 
     // The window shows it too (under a virtual X server; make test installs xvfb).
+    let scene = common::data("scenes/freeform/csg-holes.ron");
     let args = ["--size", "96x72", "--sun", "120,30"].map(std::ffi::OsStr::new);
     let mut all = vec![scene.as_os_str()];
     all.extend(args);
     common::player_in_window(&all, 2);
 }
 
-/// What the GPU cannot evaluate is refused before a frame, naming the file.
+/// Shape textures in the player: the DEM planet (sphere carrier), and the morphing grid whose
+/// headless frames sweep the morph from the first grid (frame 0) to the second (the last).
 #[test]
-fn the_player_refuses_a_shape_texture_with_a_message() {
+fn the_player_draws_shape_textures_and_morphs_them_over_frames() {
+    if common::gpu().is_none() {
+        return;
+    }
+    // Measured (96x72, lavapipe, the scenes' suns): planet 69 of 6,912 pixels (1.0 %) off by
+    // more than 8/255, mean 0.60/255 — scattered single pixels on the lit side: a pixel covers
+    // several height samples, the bilinear surface's normal jumps across every sample line,
+    // and the f32 and f64 hit points (1e-5 apart) land on either side of one; bounds 5 % and
+    // 2/255. morph-grid frames 0 and 2 against morph 0 and 1: 0 and 1 pixels, means 0.000 and
+    // 0.003; bounds 1 % and 1/255 as for csg-holes. Frame 2 against morph 0: 1,277 pixels.
+    for (scene, frames, frame, morph, off_pct, mean_max) in [
+        ("scenes/freeform/planet.ron", 1, 0, 0.0, 5, 2.0),
+        ("scenes/freeform/morph-grid.ron", 3, 0, 0.0, 1, 1.0),
+        ("scenes/freeform/morph-grid.ron", 3, 2, 1.0, 1, 1.0),
+    ] {
+        // (The scene's sun: a --sun turns over the frames.)
+        let (off, n, mean) = player_vs_cpu(scene, "96x72", None, frames, frame, morph);
+        assert!(
+            off * 100 <= n * off_pct,
+            "{scene} frame {frame}: {off} of {n} pixels differ"
+        );
+        assert!(
+            mean < mean_max,
+            "{scene} frame {frame}: mean difference {mean}/255"
+        );
+    }
+    // The morph shows: the last frame is not the first (the crater against the hills).
+    let (off, n, _) = player_vs_cpu("scenes/freeform/morph-grid.ron", "96x72", None, 3, 2, 0.0);
+    assert!(
+        off * 10 >= n,
+        "frame 2 looks like morph 0: only {off} of {n} pixels differ"
+    );
+}
+
+/// What the GPU cannot evaluate is refused before a frame, naming the file: a CSG tree with
+/// more pending operands than the kernel's stack.
+#[test]
+fn the_player_refuses_a_csg_tree_deeper_than_the_kernel_with_a_message() {
     if common::gpu().is_none() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
+    let spheres: Vec<String> = (0..9)
+        .map(|i| {
+            format!(
+                "Surface(base: Sphere(radius: 0.3), transform: (translate: ({}.0, 0.0, 0.0)))",
+                i
+            )
+        })
+        .collect();
+    let scene = dir.path().join("wide.ron");
+    std::fs::write(
+        &scene,
+        format!("Freeform(shape: Union([{}]))", spheres.join(", ")),
+    )
+    .unwrap();
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
-        .arg(common::data("scenes/freeform/morph-grid.ron"))
+        .arg(&scene)
         .args(["--headless", "--size", "32x24", "--quiet", "--out"])
         .arg(dir.path().join("f"))
         .output()
         .unwrap();
     let err = common::expect_code(&o, 3);
     assert!(
-        err.contains("morph-grid.ron") && err.contains("shape textures"),
+        err.contains("wide.ron") && err.contains("pending operands"),
         "{err}"
     );
     assert!(!dir.path().join("f").exists(), "no partial output");

@@ -31,7 +31,8 @@ struct Cli {
     /// Render without a window into --out
     #[arg(long)]
     headless: bool,
-    /// Frames to render headless (the sun turns a full circle over them when --sun is given)
+    /// Frames to render headless (the sun turns a full circle over them when --sun is given;
+    /// the shape textures of a freeform scene morph from their first grid to their second)
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
     /// Output directory for headless frames (PNG) and frames.json

@@ -20,7 +20,8 @@
 //! So `h = 0.8·√(2·tolerance/κ)` (0.8 for the slope term and curvature between vertices),
 //! clamped to `[tolerance, extent/16]`: at `h ≤ tolerance` any triangle point is within `h` of a
 //! vertex whatever the curvature, and that floor is also used when some triangle joins two
-//! surfaces (a CSG crease, where curvature is unbounded). κ is measured: the exact principal
+//! surfaces (a CSG crease, where curvature is unbounded) or lies on a shape texture (bilinear
+//! per sample cell, its slope jumps across sample lines). κ is measured: the exact principal
 //! curvatures (analytic Hessian of quadrics and perturbations) at every vertex of a pilot mesh,
 //! starting at `extent/16` and re-meshing at the rule's spacing until the spacing used meets the
 //! rule for what was seen (at most 8 passes).
@@ -99,11 +100,6 @@ pub fn polygonise(field: &Field, params: &MeshParams) -> Result<Mesh> {
 
 /// [`polygonise`], also reporting the spacing, curvature and passes.
 pub fn polygonise_with_stats(field: &Field, params: &MeshParams) -> Result<(Mesh, MeshStats)> {
-    if !field.textures.is_empty() {
-        return Err(Error::knob(
-            "freeform mesh does not take shape textures yet (its spacing comes from the quadrics' curvature): mesh the height grid as terrain instead",
-        ));
-    }
     let MeshParams { lo, hi, tolerance } = *params;
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(Error::knob(format!(
@@ -339,13 +335,19 @@ impl Grid {
             keys.iter().map(|&k| (k, self.vertex(field, k))).collect();
         let leaf: Vec<usize> = verts.iter().map(|v| field.eval_with_leaf(v.1).1).collect();
         let leaf_of = |k: &u64| leaf[keys.binary_search(k).expect("key of this block")];
-        let crease = polys.iter().any(|p| {
-            let l0 = leaf_of(&p[0]);
-            p.iter().any(|k| *k != NO_VERTEX && leaf_of(k) != l0)
-        });
+        // A shape texture is bilinear per sample cell: its slope jumps across every sample
+        // line, a crease as sharp as a CSG one.
+        let textured = leaf.iter().any(|&l| field.leaves[l].texture.is_some());
+        let crease = textured
+            || polys.iter().any(|p| {
+                let l0 = leaf_of(&p[0]);
+                p.iter().any(|k| *k != NO_VERTEX && leaf_of(k) != l0)
+            });
         let kappa = verts
             .iter()
-            .map(|v| curvature(field, v.1))
+            .zip(&leaf)
+            .filter(|(_, &l)| field.leaves[l].texture.is_none())
+            .map(|(v, _)| curvature(field, v.1))
             .fold(0.0, f64::max);
         Block {
             polys,

@@ -8,6 +8,7 @@
 //! - [`bounds`]: interval and affine bounds of the field over a view-pyramid cell;
 //! - [`texture`]: shape textures (a height grid displacing a plane or sphere), their bounds
 //!   from the min/max mipmap and their certified cast;
+//! - [`twin`], [`twin_cast`], [`twin_texture`]: the f32 twin of the GPU kernel;
 //! - [`view`]: the f64 camera and its cells; [`rmlrc`]: the multilevel caster;
 //! - [`shade`]: normals, sun lighting and shadows, frames.
 //!
@@ -25,6 +26,7 @@ pub mod shade;
 pub mod texture;
 pub mod twin;
 pub mod twin_cast;
+pub mod twin_texture;
 pub mod view;
 
 pub use bounds::Bound;

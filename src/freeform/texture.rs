@@ -232,6 +232,16 @@ impl Texture {
         self.mip = MinMaxMipmap::build(&grid_map(w, h, self.heights.clone()));
     }
 
+    /// Whether the texture has a second grid to morph toward.
+    pub fn morphs(&self) -> bool {
+        self.to.is_some()
+    }
+
+    /// The mipmaps of the sample differences along x and along y.
+    pub fn slope_mips(&self) -> [&MinMaxMipmap; 2] {
+        [&self.slope_mip[0], &self.slope_mip[1]]
+    }
+
     fn wraps(&self) -> bool {
         matches!(self.carrier, CarrierGeom::Sphere { .. })
     }

@@ -21,6 +21,7 @@
 //! (lavapipe) returns the twin's hit mask, depths and normals.
 
 use super::field::{Field, Op, Quad};
+use super::twin_texture;
 use super::view::View;
 use crate::error::{Error, Result};
 
@@ -33,6 +34,9 @@ const KC: f32 = 9.536_743e-7; // 2^-20
 const KQ: f32 = 1.525_878_9e-5; // 2^-16
 const KR: f32 = 9.536_743e-7; // 2^-20
 const TINY: f32 = 1e-30;
+/// The most shape-texture words uploaded with the program (120 MiB: wgpu's default storage
+/// binding size is 128 MiB).
+const MAX_TEXTURE_WORDS: usize = 30 << 20;
 
 /// A quadric for the GPU: `a00 a01 a02 a11 | a12 a22 b0 b1 | b2 c 0 0`.
 #[repr(C)]
@@ -67,6 +71,9 @@ pub struct GpuField {
     /// `kind << 24 | slot << 16 | leaf`: kind 0 leaf into slot, 1 min / 2 max of slots
     /// (slot, slot + 1) into slot, 3 negate slot.
     pub ops: Vec<u32>,
+    /// Shape-texture records (`twin_texture`), uploaded after `ops` in the kernel's `ops`
+    /// buffer; a textured leaf has `range = [0, 0, 1, record offset]`.
+    pub textures: Vec<u32>,
 }
 
 fn recentre(q: &Quad, eye: [f64; 3]) -> GpuQuad {
@@ -102,12 +109,6 @@ impl GpuField {
 
     /// The field relative to `eye`, refused when its CSG stack is deeper than the kernel's.
     pub fn upload(field: &Field, eye: [f64; 3]) -> Result<GpuField> {
-        if !field.textures.is_empty() {
-            return Err(Error::knob(format!(
-                "the GPU caster does not evaluate shape textures yet (this scene has {}): cast it on the CPU (--method rmlrc or reference)",
-                field.textures.len()
-            )));
-        }
         let mut depth = 0usize;
         let mut deepest = 0usize;
         // Min(n)/Max(n) become n − 1 binary ops, and every op names its stack slot (computed
@@ -140,13 +141,29 @@ impl GpuField {
             )));
         }
         let rel = |p: [f64; 3]| -> [f32; 3] { std::array::from_fn(|k| (p[k] - eye[k]) as f32) };
+        let mut textures = Vec::new();
+        let records: Vec<u32> = field
+            .textures
+            .iter()
+            .map(|t| twin_texture::append(t, t.slope_mips(), eye, &mut textures))
+            .collect();
+        if textures.len() > MAX_TEXTURE_WORDS {
+            return Err(Error::knob(format!(
+                "the shape textures take {} MiB on the GPU, more than its {} MiB: raise their lod",
+                textures.len() * 4 >> 20,
+                MAX_TEXTURE_WORDS * 4 >> 20
+            )));
+        }
         Ok(GpuField {
             leaves: field
                 .leaves
                 .iter()
                 .map(|l| GpuLeaf {
                     base: recentre(&l.base, eye),
-                    range: [l.bumps.start as u32, l.bumps.len() as u32, 0, 0],
+                    range: match l.texture {
+                        Some(t) => [0, 0, 1, records[t]],
+                        None => [l.bumps.start as u32, l.bumps.len() as u32, 0, 0],
+                    },
                     material: [
                         l.color[0] as f32,
                         l.color[1] as f32,
@@ -179,6 +196,7 @@ impl GpuField {
                 })
                 .collect(),
             ops,
+            textures,
         })
     }
 }
@@ -360,6 +378,11 @@ pub fn field_range32(f: &GpuField, cell: &Cell32) -> (f32, f32) {
         match kind {
             0 => {
                 let leaf = &f.leaves[arg as usize];
+                if leaf.range[2] != 0 {
+                    let (l, h) = twin_texture::range32(&f.textures, leaf.range[3] as usize, lo, hi);
+                    stack[slot] = Aff32::hull(l, h);
+                    continue;
+                }
                 let mut r = quad_aff32(&leaf.base, cell);
                 let (start, count) = (leaf.range[0] as usize, leaf.range[1] as usize);
                 for b in &f.bumps[start..start + count] {

@@ -3,6 +3,7 @@
 //! [`super::twin`], and the eye at the origin.
 
 use super::twin::{exp32, field_range32, GpuField, GpuQuad, View32};
+use super::twin_texture;
 
 /// A tile's log-depth range; empty when `lo > hi`.
 pub type Range32 = [f32; 2];
@@ -75,6 +76,9 @@ fn quad_grad(q: &GpuQuad, p: [f32; 3]) -> [f32; 3] {
 
 fn leaf_value(f: &GpuField, i: usize, p: [f32; 3]) -> f32 {
     let leaf = &f.leaves[i];
+    if leaf.range[2] != 0 {
+        return twin_texture::value32(&f.textures, leaf.range[3] as usize, p);
+    }
     let mut v = quad_eval(&leaf.base, p);
     let (start, count) = (leaf.range[0] as usize, leaf.range[1] as usize);
     for b in &f.bumps[start..start + count] {
@@ -115,6 +119,9 @@ pub fn normal32(f: &GpuField, p: [f32; 3]) -> [f32; 3] {
     let (_, i, sign) = eval32(f, p);
     let leaf = &f.leaves[i];
     let mut g = quad_grad(&leaf.base, p);
+    if leaf.range[2] != 0 {
+        g = twin_texture::gradient32(&f.textures, leaf.range[3] as usize, p);
+    }
     let (start, count) = (leaf.range[0] as usize, leaf.range[1] as usize);
     for b in &f.bumps[start..start + count] {
         let q = quad_eval(&b.q, p);

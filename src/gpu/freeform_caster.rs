@@ -202,7 +202,9 @@ impl FreeformCaster {
                 &field.bumps
             },
         );
-        let ops = compute::storage(gpu, "freeform ops", &field.ops);
+        // The program, then the shape-texture records it names.
+        let program: Vec<u32> = field.ops.iter().chain(&field.textures).copied().collect();
+        let ops = compute::storage(gpu, "freeform ops", &program);
         let pixels = w as u64 * h as u64;
         let hits = compute::output(gpu, "freeform hits", pixels * 16);
         let state = compute::output(gpu, "freeform shading state", pixels * 16);

@@ -181,6 +181,7 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "direct_light.wgsl",
     "freeform.wgsl",
     "freeform_shade.wgsl",
+    "freeform_texture.wgsl",
     "gather_compressed.wgsl",
     "gather_dense.wgsl",
     "lighting.wgsl",

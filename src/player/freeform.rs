@@ -36,6 +36,7 @@ pub struct FreeformPlayer {
     pub target: RenderTarget,
     sun: Sun,
     params: RmlrcParams,
+    morph: f64,
 }
 
 impl FreeformPlayer {
@@ -43,7 +44,7 @@ impl FreeformPlayer {
     pub fn load(gpu: &Gpu, path: &Path, width: u32, height: u32) -> Result<FreeformPlayer> {
         let scene = crate::load::freeform_scene(path)?;
         let field = Field::compile(&scene.shape).map_err(|e| Error::input(path, e))?;
-        // Refuse what the kernel cannot evaluate before any frame (shape textures, deep CSG).
+        // Refuse what the kernel cannot evaluate before any frame (deep CSG, huge textures).
         GpuField::upload(&field, [0.0; 3]).map_err(|e| Error::input(path, e))?;
         let sun = scene.sun.map_or(DEFAULT_SUN, |s| Sun {
             azimuth_deg: s.azimuth,
@@ -57,6 +58,7 @@ impl FreeformPlayer {
             field,
             sun,
             params: RmlrcParams::default(),
+            morph: 0.0,
         })
     }
 
@@ -85,6 +87,15 @@ impl FreeformPlayer {
     pub fn set_sun(&mut self, sun: Option<Sun>) {
         if let Some(s) = sun {
             self.sun = s;
+        }
+    }
+
+    /// Morph the shape textures that have a second grid to parameter `s` ∈ [0, 1] (the
+    /// headless player sweeps 0 → 1 over its `--frames`).
+    pub fn set_morph(&mut self, s: f64) {
+        if s != self.morph && self.field.textures.iter().any(|t| t.morphs()) {
+            self.field.set_morph(s);
+            self.morph = s;
         }
     }
 

@@ -60,6 +60,7 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
         let sun = plan.sun.map(|s| sun_of_frame(s, f, plan.frames));
         let t0 = Instant::now();
         player.set_sun(gpu, sun)?;
+        player.set_phase(f as f64 / (plan.frames.max(2) - 1) as f64);
         player.render(gpu, &camera, &plan.settings, &mut timer)?;
         let cpu_ms = t0.elapsed().as_secs_f64() * 1e3;
         let gpu_ms = timer

@@ -127,6 +127,14 @@ impl Player {
         }
     }
 
+    /// Set the animation phase in [0, 1] (a freeform scene's texture morph; other scenes have
+    /// no animation).
+    pub fn set_phase(&mut self, phase: f64) {
+        if let Player::Freeform(f) = self {
+            f.set_morph(phase);
+        }
+    }
+
     /// Render one frame into the player's target.
     pub fn render(
         &mut self,
