@@ -36,11 +36,14 @@
 //! concatenated in order), vertices are numbered by sorted edge key, triangles in walk order:
 //! the same output for any rayon thread count.
 //!
+//! A scene that is one shape texture is meshed by its carrier's sample grid instead
+//! ([`super::mesh_texture`]).
+//!
 //! [`hausdorff_to_surface`] and [`coverage_distance`] measure the error both ways (for tests
 //! and reports); [`write_obj`] writes Wavefront OBJ.
 
 use super::bounds::{field_range, Bound, Cell, Work};
-use super::field::{dot, Field, Leaf};
+use super::field::{dot, Field, Leaf, Op};
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 
@@ -72,8 +75,11 @@ pub struct MeshStats {
     pub crease: bool,
     /// Passes run (pilots and the final one).
     pub passes: u32,
-    /// Cells of the final grid along x, y, z.
+    /// Cells of the final grid along x, y, z (marching tetrahedra; 0 for a carrier grid).
     pub grid: [u32; 3],
+    /// Points per sample cell and axis of a shape texture meshed by its carrier grid
+    /// ([`super::mesh_texture`]); 0 when marching tetrahedra made the mesh.
+    pub subdivision: u32,
 }
 
 const SAFETY: f64 = 0.8;
@@ -100,6 +106,21 @@ pub fn polygonise(field: &Field, params: &MeshParams) -> Result<Mesh> {
 
 /// [`polygonise`], also reporting the spacing, curvature and passes.
 pub fn polygonise_with_stats(field: &Field, params: &MeshParams) -> Result<(Mesh, MeshStats)> {
+    // One textured surface: its own sample grid is the better mesh (no creases to floor at).
+    if let ([Op::Leaf(0)], [leaf]) = (field.ops.as_slice(), field.leaves.as_slice()) {
+        if let Some(t) = leaf.texture {
+            let (mesh, k, spacing) =
+                super::mesh_texture::polygonise(&field.textures[t], params.tolerance)?;
+            let stats = MeshStats {
+                spacing,
+                crease: true,
+                passes: 1,
+                subdivision: k,
+                ..MeshStats::default()
+            };
+            return Ok((mesh, stats));
+        }
+    }
     let MeshParams { lo, hi, tolerance } = *params;
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(Error::knob(format!(

@@ -4,7 +4,7 @@
 //! reference along grid lines, brute-force point–triangle distances). Together they bound the
 //! Hausdorff distance the mesher promises (`mesh.rs`).
 
-use super::field::{dot, Field};
+use super::field::{dot, Field, Op};
 use super::mesh::{bits, cross, dist, gradient, lerp, restrict, sub, Mesh};
 use super::reference::first_hit;
 use rayon::prelude::*;
@@ -26,11 +26,23 @@ fn project(field: &Field, x: [f64; 3]) -> Option<[f64; 3]> {
     None
 }
 
+/// For a field that is one shape texture, its distance bound along the carrier's normal (where
+/// Newton fails: near the poles of a sphere carrier); infinity otherwise.
+fn texture_bound(field: &Field, x: [f64; 3]) -> f64 {
+    match (field.ops.as_slice(), field.leaves.as_slice()) {
+        ([Op::Leaf(0)], [leaf]) => leaf
+            .texture
+            .map_or(f64::INFINITY, |t| field.textures[t].distance_bound(x)),
+        _ => f64::INFINITY,
+    }
+}
+
 /// The distance from `x` to the surface, from above: to the [`project`] foot, or when Newton
 /// does not converge to the nearer exact hit of the rays along ±∇f.
 pub fn surface_distance(field: &Field, x: [f64; 3]) -> f64 {
+    let along_normal = texture_bound(field, x);
     if let Some(p) = project(field, x) {
-        return dist(p, x);
+        return dist(p, x).min(along_normal);
     }
     let (_, g, _) = gradient(field, x);
     let len = dot(g, g).sqrt();
@@ -43,7 +55,7 @@ pub fn surface_distance(field: &Field, x: [f64; 3]) -> f64 {
     hit(1.0)
         .into_iter()
         .chain(hit(-1.0))
-        .fold(f64::INFINITY, f64::min)
+        .fold(along_normal, f64::min)
 }
 
 /// The one-sided Hausdorff distance mesh → surface: the largest [`surface_distance`] over
@@ -80,7 +92,9 @@ pub fn hausdorff_to_surface(field: &Field, mesh: &Mesh, samples_per_triangle: us
         let bhi: [f64; 3] = std::array::from_fn(|k| lo[k] + (g[0].0[k] + 2) as f64 * s);
         let local = restrict(field, blo, bhi);
         let d = |x: [f64; 3]| match project(&local, x) {
-            Some(p) if (0..3).all(|k| p[k] >= blo[k] && p[k] <= bhi[k]) => dist(p, x),
+            Some(p) if (0..3).all(|k| p[k] >= blo[k] && p[k] <= bhi[k]) => {
+                dist(p, x).min(texture_bound(field, x))
+            }
             _ => surface_distance(field, x),
         };
         let mut worst = 0.0f64;

@@ -19,6 +19,7 @@ pub mod bounds;
 pub mod field;
 pub mod mesh;
 pub mod mesh_error;
+pub mod mesh_texture;
 pub mod poly;
 pub mod reference;
 pub mod rmlrc;

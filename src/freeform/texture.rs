@@ -305,6 +305,75 @@ impl Texture {
         d - self.height_at(x, y)
     }
 
+    /// The surface point at continuous sample coordinates (x, y): the carrier point displaced
+    /// by the bilinear height (on a sphere y runs from −0.5, the north pole, to height − 0.5).
+    pub fn point_at(&self, x: f64, y: f64) -> [f64; 3] {
+        let h = self.height_at(x, y);
+        match self.carrier {
+            CarrierGeom::Plane {
+                origin,
+                u,
+                v,
+                n,
+                scale,
+            } => {
+                let (a, b) = (x / scale[0], y / scale[1]);
+                std::array::from_fn(|k| origin[k] + a * u[k] + b * v[k] + h * n[k])
+            }
+            CarrierGeom::Sphere { centre, radius } => {
+                let lon = (x + 0.5) / self.width as f64 * 2.0 * PI - PI;
+                let colat = (y + 0.5) / self.height as f64;
+                let lat = 0.5 * PI - colat * PI;
+                // The poles exactly on the axis (cos(π/2) is not 0 in f64).
+                let d = match colat {
+                    c if c <= 0.0 => [0.0, 1.0, 0.0],
+                    c if c >= 1.0 => [0.0, -1.0, 0.0],
+                    _ => [lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()],
+                };
+                std::array::from_fn(|k| centre[k] + (radius + h) * d[k])
+            }
+        }
+    }
+
+    /// An upper bound of the distance from p to the (closed) surface: |F(p)| — F is the signed
+    /// distance along the carrier's normal to the displaced surface, whose height depends on
+    /// the carrier point alone. On a sphere, where the longitudes converge and the surface
+    /// folds onto the polar axis (Newton projection fails there), also the distance to the
+    /// polar segments and, within two rows of a pole, to the nearest of 17×17 surface points
+    /// over ±1 sample around p's coordinates.
+    pub fn distance_bound(&self, p: [f64; 3]) -> f64 {
+        let mut best = self.value(p).abs();
+        if let CarrierGeom::Sphere { centre, radius } = self.carrier {
+            // The polar segments: every longitude's surface meets the axis at its pole row's
+            // height, so the closure holds the segment of those heights.
+            let r = sub(p, centre);
+            let off_axis = (r[0] * r[0] + r[2] * r[2]).sqrt();
+            for (row, sign) in [(0, 1.0), (self.height - 1, -1.0)] {
+                let hs = &self.heights[row * self.width..(row + 1) * self.width];
+                let (lo, hi) = hs
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                        (l.min(v as f64), h.max(v as f64))
+                    });
+                let along = sign * r[1];
+                let nearest = along.clamp(radius + lo, radius + hi);
+                best = best.min((off_axis * off_axis + (along - nearest).powi(2)).sqrt());
+            }
+            let (_, x, y) = self.coords(p);
+            let h = self.height as f64;
+            if y < 2.0 || y > h - 3.0 {
+                for i in 0..17 {
+                    for j in 0..17 {
+                        let yy = (y + (j as f64 - 8.0) / 8.0).clamp(-0.5, h - 0.5);
+                        let q = self.point_at(x + (i as f64 - 8.0) / 8.0, yy);
+                        best = best.min(norm(sub(p, q)));
+                    }
+                }
+            }
+        }
+        best
+    }
+
     /// `∇F(p)` by central differences a hundredth of a sample apart (the bilinear surface has
     /// no gradient on sample lines; this gives the one-sided mean there).
     pub fn gradient(&self, p: [f64; 3]) -> [f64; 3] {

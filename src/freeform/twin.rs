@@ -150,8 +150,8 @@ impl GpuField {
         if textures.len() > MAX_TEXTURE_WORDS {
             return Err(Error::knob(format!(
                 "the shape textures take {} MiB on the GPU, more than its {} MiB: raise their lod",
-                textures.len() * 4 >> 20,
-                MAX_TEXTURE_WORDS * 4 >> 20
+                (textures.len() * 4) >> 20,
+                (MAX_TEXTURE_WORDS * 4) >> 20
             )));
         }
         Ok(GpuField {

@@ -269,12 +269,16 @@ fn mesh(a: &MeshArgs, json: bool, quiet: bool) -> Result<i32> {
     })?;
     let obj = mesh::obj_bytes(&m);
     let ron = std::fs::metadata(&a.scene).map(|m| m.len()).unwrap_or(0);
+    // The height samples a textured scene describes (f32 each), beside its RON text.
+    let texture_bytes: usize = field.textures.iter().map(|t| 4 * t.heights.len()).sum();
     if json {
         let j = json!({
             "scene": a.scene.display().to_string(), "out": a.out.display().to_string(),
             "tolerance": a.tolerance, "triangles": m.triangles.len(), "vertices": m.positions.len(),
             "obj_bytes": obj, "scene_bytes": ron, "seconds": seconds,
             "spacing": stats.spacing, "crease": stats.crease, "grid": stats.grid,
+            "method": if stats.subdivision > 0 { "carrier-grid" } else { "marching-tetrahedra" },
+            "subdivision": stats.subdivision, "texture_bytes": texture_bytes,
         });
         println!("{}", serde_json::to_string_pretty(&j).expect("json"));
     } else if !quiet {
