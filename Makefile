@@ -97,6 +97,9 @@ docs-images: build
 	$(PLAYER) scenes/freeform/csg-holes.ron --headless -q --size 320x240 --sun 200,35 \
 	    --out $(DOCS_OUT)/freeform-frames
 	cp $(DOCS_OUT)/freeform-frames/frame_0000.png docs/images/freeform-player.png
+	$(PLAYER) scenes/freeform/column.ron --headless -q --size 320x240 \
+	    --out $(DOCS_OUT)/freeform-column-frames
+	cp $(DOCS_OUT)/freeform-column-frames/frame_0000.png docs/images/freeform-column.png
 	$(BAKE) -q study radiosity --out $(DOCS_OUT)/study/radiosity
 	$(BAKE) -q study compression --out $(DOCS_OUT)/study/compression
 	$(BAKE) -q study terrain --sizes 512,1024,2048 --elevations 5,30 --soft-elevations 2,5 \

@@ -5,8 +5,9 @@
 //! against the reference in the same run. On Mesa's lavapipe the "GPU" time is a software
 //! rasteriser's CPU time.
 //!
-//! `cargo bench --bench freeform_frames [-- --all] [-- --cpu-only]` (`--cpu-only` skips the
-//! GPU: a 256-perturbation frame at 640x480 takes 20 minutes on lavapipe).
+//! `cargo bench --bench freeform_frames [-- --all] [-- --cpu-only] [-- --perturbations N]`
+//! (`--cpu-only` skips the GPU: a 256-perturbation frame at 640x480 takes 20 minutes on
+//! lavapipe; `--perturbations N` runs only the scene with N of them).
 
 use relume::freeform::rmlrc::{camera_outside, cast, RmlrcParams};
 use relume::freeform::shade::primary;
@@ -27,6 +28,12 @@ fn seconds(f: impl FnOnce()) -> f64 {
 fn main() {
     let all = std::env::args().any(|a| a == "--all");
     let cpu_only = std::env::args().any(|a| a == "--cpu-only");
+    let args: Vec<String> = std::env::args().collect();
+    let only: Option<u32> = args
+        .iter()
+        .position(|a| a == "--perturbations")
+        .and_then(|i| args.get(i + 1))
+        .map(|v| v.parse().expect("--perturbations takes 16, 64 or 256"));
     let sizes: &[(u32, u32)] = if all {
         &[(640, 480), (1280, 720), (1920, 1080)]
     } else {
@@ -46,7 +53,10 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for n in [16, 64, 256] {
+    for n in [16, 64, 256]
+        .into_iter()
+        .filter(|n| only.is_none_or(|o| o == *n))
+    {
         let scene =
             FreeformScene::load(&root.join(format!("scenes/freeform/bench/terrain-{n}.ron")))
                 .unwrap();

@@ -63,7 +63,7 @@ fn tex_ranged(at: u32, m: u32, xl: f32, xh: f32, yl: f32, yh: f32) -> vec2<f32> 
     }
     let y0 = tex_clampi(floor(yl), h);
     let ys = vec2<u32>(y0, max(tex_clampi(ceil(yh), h), y0));
-    if (tw(at) != 1u) {
+    if (tw(at) == 0u) {
         let x0 = tex_clampi(floor(xl), w);
         return tex_mip_range(at, m, vec2<u32>(x0, max(tex_clampi(ceil(xh), w), x0)), ys);
     }
@@ -89,7 +89,7 @@ fn tex_height_at(at: u32, xin: f32, yin: f32) -> f32 {
     var i0: u32;
     var i1: u32;
     var fx: f32;
-    if (tw(at) == 1u) {
+    if (tw(at) != 0u) {
         let x = tex_wrap(xin, f32(w));
         i0 = min(u32(floor(x)), w - 1u);
         i1 = (i0 + 1u) % w;
@@ -107,11 +107,14 @@ fn tex_height_at(at: u32, xin: f32, yin: f32) -> f32 {
 
 fn tex_coords(at: u32, p: vec3<f32>) -> vec3<f32> {
     let q = p - tv3(at + 8u);
-    if (tw(at) != 1u) {
+    if (tw(at) == 0u) {
         return vec3<f32>(tdot(tv3(at + 20u), q), tdot(tv3(at + 12u), q) * tf(at + 15u), tdot(tv3(at + 16u), q) * tf(at + 19u));
     }
     let w = f32(tw(at + 1u));
     let h = f32(tw(at + 2u));
+    if (tw(at) == 2u) {
+        return vec3<f32>(sqrt(q.x * q.x + q.z * q.z) - tf(at + 11u), (atan2(q.z, q.x) + TEX_PI) / (2.0 * TEX_PI) * w - 0.5, q.y * tf(at + 19u));
+    }
     let rho = len3(q);
     let lon = atan2(q.z, q.x);
     var lat = 0.0;
@@ -127,11 +130,13 @@ fn tex_value(at: u32, p: vec3<f32>) -> f32 {
 fn tex_gradient(at: u32, p: vec3<f32>) -> vec3<f32> {
     let w = tw(at + 1u);
     let h = tw(at + 2u);
-    var spacing: f32;
+    let q = p - tv3(at + 8u);
+    var spacing = 1.0 / max(tf(at + 15u), tf(at + 19u));
     if (tw(at) == 1u) {
-        spacing = max(len3(p - tv3(at + 8u)), tf(at + 11u) * 1e-6) * TEX_PI / f32(max(h, w / 2u));
-    } else {
-        spacing = 1.0 / max(tf(at + 15u), tf(at + 19u));
+        spacing = max(len3(q), tf(at + 11u) * 1e-6) * TEX_PI / f32(max(h, w / 2u));
+    } else if (tw(at) == 2u) {
+        let axis = max(sqrt(q.x * q.x + q.z * q.z), tf(at + 11u) * 1e-6);
+        spacing = min(axis * 2.0 * TEX_PI / f32(w), 1.0 / tf(at + 19u));
     }
     let step = 0.01 * spacing;
     var g: vec3<f32>;
@@ -153,6 +158,20 @@ fn tex_slopes(at: u32, xs: vec2<f32>, ys: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(tex_ranged(at, 6u, x0, x1, y0, y1).x, tex_ranged(at, 7u, x0, x1, y0, y1).x);
 }
 
+// The sample x range (padded by px) of atan2(z, x) over the xz-rectangle of [lo, hi], which
+// does not contain the axis: the extremes are at its corners.
+fn tex_angle_range(lo: vec3<f32>, hi: vec3<f32>, w: f32, px: f32) -> vec2<f32> {
+    let mid = atan2(0.5 * (lo.z + hi.z), 0.5 * (lo.x + hi.x));
+    let d0 = tex_wrap(atan2(lo.z, lo.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
+    let d1 = tex_wrap(atan2(hi.z, lo.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
+    let d2 = tex_wrap(atan2(lo.z, hi.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
+    let d3 = tex_wrap(atan2(hi.z, hi.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
+    let a = min(min(d0, d1), min(d2, d3));
+    let b = max(max(d0, d1), max(d2, d3));
+    let k = w / (2.0 * TEX_PI);
+    return vec2<f32>((mid + a + TEX_PI) * k - 0.5 - px, (mid + b + TEX_PI) * k - 0.5 + px);
+}
+
 // The widened range of F over the box [lo, hi].
 fn tex_range(at: u32, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
     let c = 0.5 * (lo + hi);
@@ -167,7 +186,7 @@ fn tex_range(at: u32, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
     var ys: vec2<f32>;
     var grad: f32;
     var pad: vec2<f32>;
-    if (tw(at) != 1u) {
+    if (tw(at) == 0u) {
         let q = c - o;
         let n = tv3(at + 20u);
         let u = tv3(at + 12u);
@@ -191,6 +210,30 @@ fn tex_range(at: u32, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
         dl = dc - dr - ds;
         dh = dc + dr + ds;
         pad = vec2<f32>(px, py);
+    } else if (tw(at) == 2u) {
+        let radius = tf(at + 11u);
+        let sy = tf(at + 19u);
+        let cs = TEX_KR * (norm1(c) + norm1(e) + norm1(o)) + TEX_TINY;
+        let lo_r = (c - e) - o - vec3<f32>(cs);
+        let hi_r = (c + e) - o + vec3<f32>(cs);
+        let near = clamp(vec2<f32>(0.0), lo_r.xz, hi_r.xz);
+        let far = max(abs(lo_r.xz), abs(hi_r.xz));
+        let dmin = sqrt(near.x * near.x + near.y * near.y) * (1.0 - TEX_KR);
+        let dmax = sqrt(far.x * far.x + far.y * far.y) * (1.0 + TEX_KR);
+        let rs = TEX_KR * radius + TEX_TINY;
+        let px = 0.02 + 4.0 * TEX_APAD * w / (2.0 * TEX_PI);
+        let py = 0.02 + TEX_KR * (abs(lo_r.y) + abs(hi_r.y)) * sy;
+        ys = vec2<f32>(lo_r.y * sy - py, hi_r.y * sy + py);
+        xs = vec2<f32>(-1.0 - px, w + px);
+        grad = TEX_INF;
+        if (dmin > 0.0) {
+            xs = tex_angle_range(lo_r, hi_r, w, px);
+            let s = tex_slopes(at, xs, ys);
+            grad = (s.x * w / (2.0 * TEX_PI * dmin) + s.y * sy) * (1.0 + TEX_KR);
+        }
+        dl = dmin - radius - rs;
+        dh = dmax - radius + rs;
+        pad = vec2<f32>(px, py);
     } else {
         let radius = tf(at + 11u);
         let cs = TEX_KR * (norm1(c) + norm1(e) + norm1(o)) + TEX_TINY;
@@ -209,15 +252,7 @@ fn tex_range(at: u32, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
         let axis = sqrt(near.x * near.x + near.z * near.z) * (1.0 - TEX_KR);
         if (dmin > 0.0) {
             if (axis > 0.0) {
-                let mid = atan2(0.5 * (lo_r.z + hi_r.z), 0.5 * (lo_r.x + hi_r.x));
-                let d0 = tex_wrap(atan2(lo_r.z, lo_r.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
-                let d1 = tex_wrap(atan2(hi_r.z, lo_r.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
-                let d2 = tex_wrap(atan2(lo_r.z, hi_r.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
-                let d3 = tex_wrap(atan2(hi_r.z, hi_r.x) - mid + TEX_PI, 2.0 * TEX_PI) - TEX_PI;
-                let a = min(min(d0, d1), min(d2, d3));
-                let b = max(max(d0, d1), max(d2, d3));
-                let k = w / (2.0 * TEX_PI);
-                xs = vec2<f32>((mid + a + TEX_PI) * k - 0.5 - px, (mid + b + TEX_PI) * k - 0.5 + px);
+                xs = tex_angle_range(lo_r, hi_r, w, px);
             }
             let up = 1.0 + TEX_KR;
             let dn = 1.0 - TEX_KR;

@@ -1,6 +1,6 @@
 //! Shape textures on the GPU (`shaders/freeform_texture.wgsl`, twin `freeform::twin_texture`):
 //! the widened f32 bound contains the f64 bound and every value it covers (proptest, plane and
-//! sphere carriers), and the kernel on lavapipe returns the twin's hits, which match the f64
+//! sphere and cylinder carriers), and the kernel on lavapipe returns the twin's hits, which match the f64
 //! multilevel caster, on the bundled textured scenes.
 
 mod common;
@@ -31,9 +31,10 @@ fn scene_text(carrier: &str, seed: &[f64]) -> String {
     )
 }
 
-const CARRIERS: [&str; 2] = [
+const CARRIERS: [&str; 3] = [
     "Plane(origin: (-2.0, 0.1, -1.5), u_axis: (0.0, 0.0, 1.0), v_axis: (1.0, 0.2, 0.0), size: (4.0, 3.0))",
     "Sphere(centre: (0.2, -0.1, 0.3), radius: 1.0)",
+    "Cylinder(base: (0.1, -1.0, -0.2), radius: 0.8, length: 2.0)",
 ];
 
 /// A box grown outward by 2⁻²⁰ relative, as the kernel's cells are (twin.rs, KC).
@@ -53,12 +54,12 @@ proptest! {
     #[test]
     fn widened_texture_bound_contains_the_f64_bound_and_the_values(
         seed in prop::collection::vec(-1.0f64..1.0, 12),
-        sphere in any::<bool>(),
+        carrier in 0usize..3,
         centre in prop::array::uniform3(-1.6f64..1.6),
         half in prop::array::uniform3(1e-4f64..0.6),
         eye in prop::array::uniform3(-5.0f64..5.0),
     ) {
-        let carrier = CARRIERS[usize::from(sphere)];
+        let carrier = CARRIERS[carrier];
         let scene = FreeformScene::parse(Path::new("t.ron"), &scene_text(carrier, &seed)).unwrap();
         let field = Field::compile(&scene.shape).unwrap();
         let gf = GpuField::upload(&field, eye).unwrap();
@@ -96,7 +97,7 @@ fn gpu_returns_the_twin_and_the_twin_the_f64_caster_on_textured_scenes() {
     let Some(gpu) = common::gpu() else { return };
     let caster = relume::gpu::freeform_caster::FreeformCaster::new(&gpu).unwrap();
     let params = RmlrcParams::default();
-    for name in ["morph-grid.ron", "planet.ron"] {
+    for name in ["morph-grid.ron", "planet.ron", "column.ron"] {
         let (field, camera) = bundled(name);
         let view = View::new(&camera, 96, 72);
         let v32 = View32::of(&view);
@@ -192,12 +193,13 @@ fn gpu_returns_the_twin_and_the_twin_the_f64_caster_on_textured_scenes() {
             assert!(worst_depth <= 1e-6 && worst_normal <= 1e-6, "{name}");
             assert_eq!(gpu_f64, 0, "{name}");
         } else {
-            // A sphere carrier goes through atan2/asin, which the driver computes otherwise than
-            // libm (WGSL allows 4096 ulps): depth beyond 1e-4 relative of the twin's on 13 of
-            // 2,705 hits (0.5 %, bounded at 1 %), normals (central differences across the
-            // bilinear kinks) beyond 0.05 on under 1 % (p99 measured 0.023); against the f64
-            // caster, 57 hits (2.1 %) on another surface — a ridge grazed at the limb — bounded
-            // at 4 %.
+            // Sphere and cylinder carriers go through atan2 (and asin), which the driver
+            // computes otherwise than libm (WGSL allows 4096 ulps): depth beyond 1e-4 relative
+            // of the twin's on 13 of 2,705 hits on the planet (0.5 %, bounded at 1 %) and 0 of
+            // 5,472 on the column; normals (central differences across the bilinear kinks)
+            // beyond 0.05 on under 1 % (p99 measured 0.023 and 6e-5); against the f64 caster,
+            // 57 planet hits (2.1 %) on another surface — ridges grazed at the limb — and 4 on
+            // the column, bounded at 4 %.
             assert!(gpu_twin * 100 <= hits, "{name}: {gpu_twin} of {hits}");
             assert!(q(0.99) <= 0.05, "{name}: normal p99 {}", q(0.99));
             assert!(far_f64 * 25 <= hits, "{name}: {far_f64} of {hits}");

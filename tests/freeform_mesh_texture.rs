@@ -112,6 +112,37 @@ fn sphere_carrier_mesh_is_within_tolerance_both_ways_poles_included() {
 }
 
 #[test]
+fn cylinder_carrier_mesh_is_within_tolerance_both_ways() {
+    // A rough 16x6 grid of heights in ±0.05 on a cylinder of radius 0.7, length 2.
+    let v: Vec<String> = (0..96)
+        .map(|i| format!("{:?}", 0.05 * (((i * 4099 + 7) % 89) as f64 / 44.0 - 1.0)))
+        .collect();
+    let text = format!(
+        "Freeform(shape: Textured(carrier: Cylinder(base: (0.1, -1.0, 0.2), radius: 0.7, length: 2.0), heights: Grid(width: 16, height: 6, values: [{}])))",
+        v.join(", ")
+    );
+    let scene = FreeformScene::parse(Path::new("t.ron"), &text).unwrap();
+    let field = Field::compile(&scene.shape).unwrap();
+    // Within the carrier's length, where the mesh ends.
+    let (lo, hi) = ([-0.8, -0.95, -0.7], [1.0, 0.95, 1.1]);
+    for tol in [0.02, 0.005] {
+        let (m, k) = mesh(&field, tol);
+        let h = hausdorff_to_surface(&field, &m, 10);
+        let c = coverage_distance(&field, &m, lo, hi, 32);
+        eprintln!(
+            "cylinder tol {tol}: k {k}, {} triangles, mesh→surface {h:.3e}, surface→mesh {c:.3e}",
+            m.triangles.len()
+        );
+        assert!(h <= tol && c <= tol, "tol {tol}: {h} / {c}");
+        // Outward: the signed volume about the axis point midway is the tube's less its two
+        // end cones, (2/3)·π·0.7²·2 ≈ 2.05 (the heights average near 0).
+        let vol = volume_about(&m, [0.1, 0.0, 0.2]);
+        let tube = 2.0 / 3.0 * std::f64::consts::PI * 0.98;
+        assert!((vol - tube).abs() < 0.3, "volume {vol}");
+    }
+}
+
+#[test]
 fn the_cli_meshes_a_texture_by_its_grid_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("m.obj");

@@ -108,6 +108,46 @@ fn a_constant_grid_on_a_sphere_carrier_is_a_larger_sphere() {
     );
 }
 
+#[test]
+fn a_constant_grid_on_a_cylinder_carrier_is_a_larger_cylinder() {
+    let carrier = "Cylinder(base: (0.2, -3.0, 0.3), radius: 1.0, length: 6.0)";
+    let s = textured(carrier, &grid(8, 4, &[0.5; 32]), "");
+    let field = Field::compile(&s.shape).unwrap();
+    let (mut worst, mut hits) = (0f64, 0);
+    for (o, d) in rays(300) {
+        // (o + t d − c)ₓ² + (o + t d − c)_z² = 1.5², from outside.
+        let (ox, oz) = (o[0] - 0.2, o[2] - 0.3);
+        let a = d[0] * d[0] + d[2] * d[2];
+        let b = ox * d[0] + oz * d[2];
+        let cc = ox * ox + oz * oz - 2.25;
+        if cc <= 0.0 {
+            continue;
+        }
+        let disc = b * b - a * cc;
+        let got = first_hit(&field, o, d, 0.0, 100.0);
+        if disc <= 1e-9 || b >= 0.0 {
+            assert!(got.is_none() || disc > -1e-6, "a miss hit");
+            continue;
+        }
+        let exact = (-b - disc.sqrt()) / a;
+        let hit = got.expect("a hit missed");
+        hits += 1;
+        worst = worst.max((hit.t - exact).abs() / exact);
+    }
+    assert!(hits > 50, "{hits}");
+    assert!(worst < 1e-9, "worst relative error {worst:e}");
+    let cylinder = FreeformScene::parse(
+        Path::new("cylinder.ron"),
+        "Freeform(shape: Surface(base: Cylinder(radius: 1.5), transform: (translate: (0.2, 0.0, 0.3))))",
+    )
+    .unwrap();
+    same_picture(
+        &field,
+        &Field::compile(&cylinder.shape).unwrap(),
+        s.camera.as_ref().unwrap(),
+    );
+}
+
 /// The multilevel caster on the textured field and on the equivalent quadric: the same hit
 /// mask except on silhouette pixels (at most 0.1 %), depths within 2 finest depth cells.
 fn same_picture(textured: &Field, quadric: &Field, camera: &FreeformCamera) {

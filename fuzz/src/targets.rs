@@ -119,8 +119,24 @@ fn freeform(path: &Path, text: &str) {
     let Ok(field) = relume::freeform::Field::compile(&scene.shape) else {
         return;
     };
-    let _ = relume::freeform::twin::GpuField::upload(&field, [0.1, 0.2, 0.3]);
+    let gpu = relume::freeform::twin::GpuField::upload(&field, [0.1, 0.2, 0.3]).ok();
     for p in [[0.0, 0.0, 0.0], [1.0, -2.0, 0.5], [1e3, 1e-3, -7.0]] {
+        // The kernel's f32 evaluation and bound (its twin), shape textures included.
+        if let Some(g) = &gpu {
+            let q = p.map(|v| v as f32);
+            let _ = relume::freeform::twin_cast::eval32(g, q);
+            let cell = relume::freeform::twin::Cell32::new(
+                q,
+                [
+                    [0.5, 0.0, 0.0],
+                    [0.0, 0.25, 0.0],
+                    [0.1, 0.0, 1.0],
+                    [0.0; 3],
+                    [0.0; 3],
+                ],
+            );
+            let _ = relume::freeform::twin::field_range32(g, &cell);
+        }
         let _ = field.eval(p);
         let _ = field.normal(p);
         let mut cell = Cell {

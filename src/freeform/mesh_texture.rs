@@ -9,7 +9,8 @@
 //! surface's by at most `|d|/4` above the same carrier point — and d, the cell's twist
 //! `h₀₀ − h₁₀ − h₀₁ + h₁₁`, shrinks as `1/k²` under a `k×k` subdivision. On a plane carrier
 //! the displacement is along the one normal, so `|d|/(4k²)` bounds the distance both ways
-//! (mesh → surface and surface → mesh). On a sphere the triangles are also chords: a cell of
+//! (mesh → surface and surface → mesh). On a cylinder (wrapped around it, open at the ends)
+//! and a sphere the triangles are also chords: a cell of
 //! angular diagonal δ at radius ρ adds its sagitta `ρ(1 − cos(δ/2))`, shrinking as `1/k²` too,
 //! and the mesher picks the least `k` whose sum of both terms is within the tolerance. The
 //! two polar caps (half a row beyond the first and last sample rows, where the height is
@@ -18,8 +19,8 @@
 //! distance of both carriers.
 //!
 //! Preconditions: a compiled texture ([`Texture`]); a plane carrier is meshed over its grid's
-//! rectangle (beyond it the clamped surface goes on; the mesher's box does not cut it) and a
-//! sphere whole. The mesh never coarsens below the grid: a coarser grid is the texture's
+//! rectangle and a cylinder over its length (beyond them the clamped surface goes on; the
+//! mesher's box does not cut it), a sphere whole. The mesh never coarsens below the grid: a coarser grid is the texture's
 //! `lod`. Output is deterministic (no threads).
 
 use super::mesh::Mesh;
@@ -38,8 +39,10 @@ pub fn polygonise(t: &Texture, tolerance: f64) -> Result<(Mesh, u32, f64)> {
     let k = subdivision(t, tolerance)?;
     let (w, h) = (t.width, t.height);
     let sphere = matches!(t.carrier, CarrierGeom::Sphere { .. });
+    let wraps = !matches!(t.carrier, CarrierGeom::Plane { .. });
+    let up = matches!(t.carrier, CarrierGeom::Cylinder { .. });
     // Vertex columns (x) and rows (y) in continuous sample coordinates.
-    let cols = if sphere {
+    let cols = if wraps {
         w * k as usize
     } else {
         (w - 1) * k as usize + 1
@@ -70,14 +73,20 @@ pub fn polygonise(t: &Texture, tolerance: f64) -> Result<(Mesh, u32, f64)> {
     }
     let at = |r: usize, c: usize| (r * cols + c % cols) as u32;
     let mut triangles = Vec::with_capacity(2 * cols * ys.len());
-    let across = if sphere { cols } else { cols - 1 };
+    let across = if wraps { cols } else { cols - 1 };
     for r in 0..ys.len() - 1 {
         for c in 0..across {
             // a (x, y), b (x+1, y), c (x, y+1), d (x+1, y+1): counter-clockwise seen from
-            // outside (u × v is the plane's normal; on a sphere x runs east and y south).
+            // outside (u × v is the plane's normal; on a sphere x runs east and y south; on a
+            // cylinder y runs up, so the turn is the other way).
             let (a, b, cc, d) = (at(r, c), at(r, c + 1), at(r + 1, c), at(r + 1, c + 1));
-            triangles.push([a, b, cc]);
-            triangles.push([b, d, cc]);
+            if up {
+                triangles.push([a, cc, b]);
+                triangles.push([b, cc, d]);
+            } else {
+                triangles.push([a, b, cc]);
+                triangles.push([b, d, cc]);
+            }
         }
     }
     // Drop triangles with coincident corners (pole vertices of equal heights).
@@ -88,6 +97,9 @@ pub fn polygonise(t: &Texture, tolerance: f64) -> Result<(Mesh, u32, f64)> {
     let spacing = match t.carrier {
         CarrierGeom::Plane { scale, .. } => 1.0 / (kf * scale[0].min(scale[1])),
         CarrierGeom::Sphere { radius, .. } => radius * 2.0 * PI / (kf * w as f64),
+        CarrierGeom::Cylinder {
+            radius, scale_y, ..
+        } => (radius * 2.0 * PI / w as f64).max(1.0 / scale_y) / kf,
     };
     Ok((
         Mesh {
@@ -108,8 +120,8 @@ fn subdivision(t: &Texture, tolerance: f64) -> Result<u32> {
     }
     let (w, h) = (t.width, t.height);
     let s = |i: usize, j: usize| t.heights[j * w + i % w] as f64;
-    let sphere = matches!(t.carrier, CarrierGeom::Sphere { .. });
-    let across = if sphere { w } else { w - 1 };
+    let wraps = !matches!(t.carrier, CarrierGeom::Plane { .. });
+    let across = if wraps { w } else { w - 1 };
     let mut twist = 0.0f64;
     for j in 0..h - 1 {
         for i in 0..across {
@@ -123,6 +135,11 @@ fn subdivision(t: &Texture, tolerance: f64) -> Result<u32> {
             let (dx, dy) = (2.0 * PI / w as f64, PI / h as f64);
             let delta = (dx * dx + dy * dy).sqrt();
             (radius + top.max(0.0)) * (1.0 - (0.5 * delta).cos())
+        }
+        // Curved around the axis only: the chord over one column.
+        CarrierGeom::Cylinder { radius, .. } => {
+            let top = t.mip.max_height as f64;
+            (radius + top.max(0.0)) * (1.0 - (PI / w as f64).cos())
         }
     };
     let e1 = 0.25 * twist + sagitta;

@@ -1,10 +1,11 @@
-//! Shape textures, compiled: a carrier surface (plane or sphere) displaced along its unit normal
+//! Shape textures, compiled: a carrier quadric (plane, sphere or cylinder) displaced along its
+//! unit normal
 //! by the bilinear interpolation of a height grid (docs/freeform.md, "Shape textures").
 //!
 //! The field is `F(p) = D(p) − h(X(p), Y(p))`: `D` the signed distance to the carrier (exact for
-//! a plane and a sphere), `(X, Y)` continuous sample coordinates of the carrier's
-//! parameterisation (plane: projections on its axes; sphere: longitude and latitude,
-//! equirectangular) and `h` the bilinear interpolation of the samples (heights in world units).
+//! these three), `(X, Y)` continuous sample coordinates of the carrier's parameterisation
+//! (plane: projections on its axes; sphere: longitude and latitude, equirectangular; cylinder:
+//! angle and height) and `h` the bilinear interpolation of the samples (heights in world units).
 //! Solid is where `F < 0`, below the displaced surface.
 //!
 //! **Bounds** over a box (the multilevel caster's cells, the reference's ray segments), two of
@@ -20,8 +21,12 @@
 //!   what lets the reference's bisection stop near a crossing.
 //!
 //! Preconditions: grids of at least 2×2 finite samples, an inline grid (the loader reads
-//! files); the sphere's parameterisation is singular at its poles and centre, where the bounds
-//! fall back to the whole height range.
+//! files); the sphere's parameterisation is singular at its poles and centre, the cylinder's on
+//! its axis, where the bounds fall back to the whole height range. Why these three carriers: the
+//! displaced surface has an exact implicit form only where the distance to the carrier and a
+//! parameterisation constant along its normals are both closed-form — true of planes, spheres and
+//! circular cylinders, not of a general quadric (an ellipsoid's normals cross, its distance is a
+//! sextic root).
 
 use crate::error::{Error, Result};
 use crate::heightmap::minmax_mipmap::MinMaxMipmap;
@@ -46,6 +51,12 @@ pub enum CarrierGeom {
     Sphere {
         centre: [f64; 3],
         radius: f64,
+    },
+    /// Axis vertical through `base`; `scale_y` = sample rows per world unit along it.
+    Cylinder {
+        base: [f64; 3],
+        radius: f64,
+        scale_y: f64,
     },
 }
 
@@ -176,6 +187,15 @@ impl Texture {
                 }
             }
             Carrier::Sphere { centre, radius } => CarrierGeom::Sphere { centre, radius },
+            Carrier::Cylinder {
+                base,
+                radius,
+                length,
+            } => CarrierGeom::Cylinder {
+                base,
+                radius,
+                scale_y: (h - 1) as f64 / length,
+            },
         };
         let mut tex = Texture {
             carrier,
@@ -243,7 +263,12 @@ impl Texture {
     }
 
     fn wraps(&self) -> bool {
-        matches!(self.carrier, CarrierGeom::Sphere { .. })
+        !matches!(self.carrier, CarrierGeom::Plane { .. })
+    }
+
+    /// Continuous sample x of the angle atan2(z, x) about a vertical axis.
+    fn angle_x(&self, z: f64, x: f64) -> f64 {
+        (z.atan2(x) + PI) / (2.0 * PI) * self.width as f64 - 0.5
     }
 
     /// `(D, X, Y)` at p: signed carrier distance and continuous sample coordinates.
@@ -272,6 +297,18 @@ impl Texture {
                     rho - radius,
                     (lon + PI) / (2.0 * PI) * self.width as f64 - 0.5,
                     (0.5 * PI - lat) / PI * self.height as f64 - 0.5,
+                )
+            }
+            CarrierGeom::Cylinder {
+                base,
+                radius,
+                scale_y,
+            } => {
+                let r = sub(p, base);
+                (
+                    (r[0] * r[0] + r[2] * r[2]).sqrt() - radius,
+                    self.angle_x(r[2], r[0]),
+                    r[1] * scale_y,
                 )
             }
         }
@@ -331,6 +368,19 @@ impl Texture {
                     _ => [lat.cos() * lon.cos(), lat.sin(), lat.cos() * lon.sin()],
                 };
                 std::array::from_fn(|k| centre[k] + (radius + h) * d[k])
+            }
+            CarrierGeom::Cylinder {
+                base,
+                radius,
+                scale_y,
+            } => {
+                let a = (x + 0.5) / self.width as f64 * 2.0 * PI - PI;
+                let r = radius + h;
+                [
+                    base[0] + r * a.cos(),
+                    base[1] + y / scale_y,
+                    base[2] + r * a.sin(),
+                ]
             }
         }
     }
@@ -394,6 +444,15 @@ impl Texture {
                 let rho = norm(sub(p, centre)).max(radius * 1e-6);
                 rho * PI / self.height.max(self.width / 2) as f64
             }
+            CarrierGeom::Cylinder {
+                base,
+                radius,
+                scale_y,
+            } => {
+                let r = sub(p, base);
+                let rho = (r[0] * r[0] + r[2] * r[2]).sqrt().max(radius * 1e-6);
+                (rho * 2.0 * PI / self.width as f64).min(1.0 / scale_y)
+            }
         }
     }
 
@@ -452,6 +511,26 @@ impl Texture {
         [0, 1].map(|k| self.ranged(&self.slope_mip[k], xs.0, xs.1, ys.0, ys.1).0 as f64)
     }
 
+    /// The continuous sample x range of the angle atan2(z, x) over the xz-rectangle of [lo, hi]
+    /// (relative to the axis, which the rectangle must not contain): the extremes are at its
+    /// corners.
+    fn angle_range(&self, lo: [f64; 3], hi: [f64; 3]) -> (f64, f64) {
+        let mid = (0.5 * (lo[2] + hi[2])).atan2(0.5 * (lo[0] + hi[0]));
+        let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+        for (x, z) in [
+            (lo[0], lo[2]),
+            (lo[0], hi[2]),
+            (hi[0], lo[2]),
+            (hi[0], hi[2]),
+        ] {
+            let d = (z.atan2(x) - mid + PI).rem_euclid(2.0 * PI) - PI;
+            a = a.min(d);
+            b = b.max(d);
+        }
+        let k = self.width as f64 / (2.0 * PI);
+        ((mid + a + PI) * k - 0.5, (mid + b + PI) * k - 0.5)
+    }
+
     /// Over the box c ± e: D's range, X's and Y's ranges, and a bound of |∇h|.
     #[allow(clippy::type_complexity)]
     fn box_coords(&self, c: [f64; 3], e: [f64; 3]) -> (f64, f64, (f64, f64), (f64, f64), f64) {
@@ -488,20 +567,7 @@ impl Texture {
                     let xs = if axis <= 0.0 {
                         all_x
                     } else {
-                        let mid = (0.5 * (lo[2] + hi[2])).atan2(0.5 * (lo[0] + hi[0]));
-                        let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
-                        for (x, z) in [
-                            (lo[0], lo[2]),
-                            (lo[0], hi[2]),
-                            (hi[0], lo[2]),
-                            (hi[0], hi[2]),
-                        ] {
-                            let d = (z.atan2(x) - mid + PI).rem_euclid(2.0 * PI) - PI;
-                            a = a.min(d);
-                            b = b.max(d);
-                        }
-                        let k = self.width as f64 / (2.0 * PI);
-                        ((mid + a + PI) * k - 0.5, (mid + b + PI) * k - 0.5)
+                        self.angle_range(lo, hi)
                     };
                     let smax = if hi[1] > 0.0 {
                         hi[1] / dmin
@@ -536,69 +602,39 @@ impl Texture {
                     grad,
                 )
             }
-        }
-    }
-
-    /// The solid set along `o + t·d` within [t0, t1]: bisection on the bounds of segments,
-    /// down to `1e-10·(1 + |t|)`, where the end points' signs decide and a sign change is
-    /// refined by bisection on F to the last bit. Certified except for a tangent touch (F
-    /// reaching 0 without changing sign) inside one tolerance interval, and beyond
-    /// [`MAX_SEGMENTS`] segments on one ray, where the segments left are decided by their end
-    /// points (a guard against pathological inputs; the bundled scenes stay far below it).
-    pub fn solid_along(&self, o: [f64; 3], d: [f64; 3], t0: f64, t1: f64) -> Vec<(f64, f64)> {
-        let mut out: Vec<(f64, f64)> = Vec::new();
-        let at = |t: f64| -> [f64; 3] { std::array::from_fn(|k| o[k] + t * d[k]) };
-        let push = |a: f64, b: f64, out: &mut Vec<(f64, f64)>| match out.last_mut() {
-            Some(last) if last.1 >= a => last.1 = last.1.max(b),
-            _ => out.push((a, b)),
-        };
-        let mut stack = vec![(t0, t1)];
-        let mut budget = MAX_SEGMENTS;
-        while let Some((a, b)) = stack.pop() {
-            budget = budget.saturating_sub(1);
-            let (pa, pb) = (at(a), at(b));
-            let lo: [f64; 3] = std::array::from_fn(|k| pa[k].min(pb[k]));
-            let hi: [f64; 3] = std::array::from_fn(|k| pa[k].max(pb[k]));
-            let (rlo, rhi) = self.range(lo, hi);
-            if rlo > 0.0 {
-                continue;
-            }
-            if rhi < 0.0 {
-                push(a, b, &mut out);
-                continue;
-            }
-            if b - a > 1e-10 * (1.0 + a.abs().max(b.abs())) && budget > 0 {
-                let m = 0.5 * (a + b);
-                stack.push((m, b));
-                stack.push((a, m));
-                continue;
-            }
-            let (fa, fb) = (self.value(pa), self.value(pb));
-            match (fa <= 0.0, fb <= 0.0) {
-                (true, true) => push(a, b, &mut out),
-                (false, false) => {}
-                (inside_a, _) => {
-                    let (mut x, mut y) = (a, b);
-                    for _ in 0..80 {
-                        let m = 0.5 * (x + y);
-                        if m <= x || m >= y {
-                            break;
-                        }
-                        if (self.value(at(m)) <= 0.0) == inside_a {
-                            x = m;
-                        } else {
-                            y = m;
-                        }
-                    }
-                    if inside_a {
-                        push(a, x, &mut out);
-                    } else {
-                        push(y, b, &mut out);
-                    }
-                }
+            CarrierGeom::Cylinder {
+                base,
+                radius,
+                scale_y,
+            } => {
+                let lo = sub(sub(c, e), base);
+                let hi = sub([c[0] + e[0], c[1] + e[1], c[2] + e[2]], base);
+                // Distances to the axis over the box's xz-rectangle.
+                let near = [0.0f64.clamp(lo[0], hi[0]), 0.0f64.clamp(lo[2], hi[2])];
+                let far = [lo[0].abs().max(hi[0].abs()), lo[2].abs().max(hi[2].abs())];
+                let dmin = (near[0] * near[0] + near[1] * near[1]).sqrt();
+                let dmax = (far[0] * far[0] + far[1] * far[1]).sqrt();
+                let ys = (lo[1] * scale_y, hi[1] * scale_y);
+                let (xs, grad) = if dmin <= 0.0 {
+                    ((-1.0, self.width as f64), f64::INFINITY)
+                } else {
+                    let xs = self.angle_range(lo, hi);
+                    let [sx, sy] = self.slopes(xs, ys);
+                    (
+                        xs,
+                        sx * self.width as f64 / (2.0 * PI * dmin) + sy * scale_y,
+                    )
+                };
+                let pad = 0.01;
+                (
+                    dmin - radius,
+                    dmax - radius,
+                    (xs.0 - pad, xs.1 + pad),
+                    (ys.0 - pad, ys.1 + pad),
+                    grad,
+                )
             }
         }
-        out
     }
 }
 

@@ -7,10 +7,10 @@
 //!
 //! | words | content |
 //! |---|---|
-//! | 0–3 | kind (0 plane, 1 sphere), width, height, mip levels L |
+//! | 0–3 | kind (0 plane, 1 sphere, 2 cylinder), width, height, mip levels L |
 //! | 4–7 | offsets (from the record's start) of the heights, the height mip, the x- and y-slope mips |
-//! | 8–11 | plane origin or sphere centre (eye-relative), sphere radius |
-//! | 12–15, 16–19, 20–23 | plane u, v, n (unit) with samples per world unit along u and v |
+//! | 8–11 | plane origin, sphere centre or cylinder base (eye-relative); radius |
+//! | 12–15, 16–19, 20–23 | plane u, v, n (unit) with samples per world unit along u and v (19: a cylinder's rows per unit) |
 //! | 24–27 | the largest and smallest height, the largest x and y sample differences |
 //! | 28… | per mip level: texel offset, width, height |
 //!
@@ -77,6 +77,18 @@ pub fn append(t: &Texture, slopes: [&MinMaxMipmap; 2], eye: [f64; 3], words: &mu
             }
             rec[11] = f(radius);
         }
+        CarrierGeom::Cylinder {
+            base,
+            radius,
+            scale_y,
+        } => {
+            rec[0] = 2;
+            for k in 0..3 {
+                rec[8 + k] = f(base[k] - eye[k]);
+            }
+            rec[11] = f(radius);
+            rec[19] = f(scale_y);
+        }
     }
     rec[24] = t.mip.max_height.to_bits();
     rec[25] = t.mip.min_height.to_bits();
@@ -114,8 +126,9 @@ impl Rec<'_> {
     fn v3(&self, i: usize) -> [f32; 3] {
         [self.f(i), self.f(i + 1), self.f(i + 2)]
     }
-    fn sphere(&self) -> bool {
-        self.u(0) == 1
+    /// 0 plane, 1 sphere, 2 cylinder (the last two wrap along x).
+    fn kind(&self) -> u32 {
+        self.u(0)
     }
     fn dims(&self) -> (u32, u32) {
         (self.u(1), self.u(2))
@@ -174,7 +187,7 @@ impl Rec<'_> {
             clampi(yl.floor(), h),
             clampi(yh.ceil(), h).max(clampi(yl.floor(), h)),
         );
-        if !self.sphere() {
+        if self.kind() == 0 {
             let x0 = clampi(xl.floor(), w);
             return self.mip_range(m, (x0, clampi(xh.ceil(), w).max(x0)), ys);
         }
@@ -198,7 +211,7 @@ impl Rec<'_> {
         let y = y.clamp(0.0, (h - 1) as f32);
         let j = (y.floor() as u32).min(h - 2);
         let fy = y - j as f32;
-        let (i0, i1, fx) = if self.sphere() {
+        let (i0, i1, fx) = if self.kind() != 0 {
             let x = wrap(x, w as f32);
             let i = (x.floor() as u32).min(w - 1);
             (i, (i + 1) % w, x - i as f32)
@@ -217,7 +230,7 @@ impl Rec<'_> {
     fn coords(&self, p: [f32; 3]) -> (f32, f32, f32) {
         let o = self.v3(8);
         let q = sub(p, o);
-        if !self.sphere() {
+        if self.kind() == 0 {
             return (
                 dot(self.v3(20), q),
                 dot(self.v3(12), q) * self.f(15),
@@ -225,6 +238,13 @@ impl Rec<'_> {
             );
         }
         let (w, h) = self.dims();
+        if self.kind() == 2 {
+            return (
+                (q[0] * q[0] + q[2] * q[2]).sqrt() - self.f(11),
+                (q[2].atan2(q[0]) + PI) / (2.0 * PI) * w as f32 - 0.5,
+                q[1] * self.f(19),
+            );
+        }
         let rho = norm(q);
         let lon = q[2].atan2(q[0]);
         let lat = if rho > 0.0 {
@@ -269,10 +289,14 @@ pub fn value32(words: &[u32], at: usize, p: [f32; 3]) -> f32 {
 pub fn gradient32(words: &[u32], at: usize, p: [f32; 3]) -> [f32; 3] {
     let r = Rec { w: &words[at..] };
     let (w, h) = r.dims();
-    let spacing = if r.sphere() {
-        norm(sub(p, r.v3(8))).max(r.f(11) * 1e-6) * PI / (h.max(w / 2) as f32)
-    } else {
-        1.0 / r.f(15).max(r.f(19))
+    let q = sub(p, r.v3(8));
+    let spacing = match r.kind() {
+        0 => 1.0 / r.f(15).max(r.f(19)),
+        1 => norm(q).max(r.f(11) * 1e-6) * PI / (h.max(w / 2) as f32),
+        _ => {
+            let axis = (q[0] * q[0] + q[2] * q[2]).sqrt().max(r.f(11) * 1e-6);
+            (axis * 2.0 * PI / w as f32).min(1.0 / r.f(19))
+        }
     };
     let step = 0.01 * spacing;
     std::array::from_fn(|k| {
@@ -294,7 +318,7 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
     let o = r.v3(8);
     let (w, h) = (r.dims().0 as f32, r.dims().1 as f32);
     // (D range, X range, Y range, |∇h| bound, pads of X and Y in samples)
-    let (dl, dh, xs, ys, grad, pad) = if !r.sphere() {
+    let (dl, dh, xs, ys, grad, pad) = if r.kind() == 0 {
         let q = sub(c, o);
         let span = |a: [f32; 3]| a[0].abs() * e[0] + a[1].abs() * e[1] + a[2].abs() * e[2];
         let (n, u, v) = (r.v3(20), r.v3(12), r.v3(16));
@@ -311,6 +335,40 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
         let s = slopes(&r, xs, ys);
         let grad = (s[0] * sx + s[1] * sy) * (1.0 + KR);
         (dc - dr - ds, dc + dr + ds, xs, ys, grad, [px, py])
+    } else if r.kind() == 2 {
+        let (radius, sy) = (r.f(11), r.f(19));
+        let cs = KR * (norm1(c) + norm1(e) + norm1(o)) + TINY;
+        let lo_r: [f32; 3] = std::array::from_fn(|k| (c[k] - e[k]) - o[k] - cs);
+        let hi_r: [f32; 3] = std::array::from_fn(|k| (c[k] + e[k]) - o[k] + cs);
+        let near = [
+            0.0f32.clamp(lo_r[0], hi_r[0]),
+            0.0f32.clamp(lo_r[2], hi_r[2]),
+        ];
+        let far = [
+            lo_r[0].abs().max(hi_r[0].abs()),
+            lo_r[2].abs().max(hi_r[2].abs()),
+        ];
+        let dmin = (near[0] * near[0] + near[1] * near[1]).sqrt() * (1.0 - KR);
+        let dmax = (far[0] * far[0] + far[1] * far[1]).sqrt() * (1.0 + KR);
+        let rs = KR * radius + TINY;
+        let px = 0.02 + 4.0 * APAD * w / (2.0 * PI);
+        let py = 0.02 + KR * (lo_r[1].abs() + hi_r[1].abs()) * sy;
+        let ys = (lo_r[1] * sy - py, hi_r[1] * sy + py);
+        let (xs, grad) = if dmin <= 0.0 {
+            ((-1.0 - px, w + px), INF)
+        } else {
+            let xs = angle_range32(lo_r, hi_r, w, px);
+            let s = slopes(&r, xs, ys);
+            (xs, (s[0] * w / (2.0 * PI * dmin) + s[1] * sy) * (1.0 + KR))
+        };
+        (
+            dmin - radius - rs,
+            dmax - radius + rs,
+            xs,
+            ys,
+            grad,
+            [px, py],
+        )
     } else {
         let radius = r.f(11);
         let cs = KR * (norm1(c) + norm1(e) + norm1(o)) + TINY;
@@ -332,20 +390,7 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
             let xs = if axis <= 0.0 {
                 all_x
             } else {
-                let mid = (0.5 * (lo_r[2] + hi_r[2])).atan2(0.5 * (lo_r[0] + hi_r[0]));
-                let corner = |x: f32, z: f32| wrap(z.atan2(x) - mid + PI, 2.0 * PI) - PI;
-                let d = [
-                    corner(lo_r[0], lo_r[2]),
-                    corner(lo_r[0], hi_r[2]),
-                    corner(hi_r[0], lo_r[2]),
-                    corner(hi_r[0], hi_r[2]),
-                ];
-                let (a, b) = (
-                    d[0].min(d[1]).min(d[2].min(d[3])),
-                    d[0].max(d[1]).max(d[2].max(d[3])),
-                );
-                let k = w / (2.0 * PI);
-                ((mid + a + PI) * k - 0.5 - px, (mid + b + PI) * k - 0.5 + px)
+                angle_range32(lo_r, hi_r, w, px)
             };
             let up = 1.0 + KR;
             let dn = 1.0 - KR;
@@ -401,6 +446,25 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
         (-INF, INF)
     };
     (mip.0.max(lip.0), mip.1.min(lip.1))
+}
+
+/// The continuous sample x range (padded by `px`) of atan2(z, x) over the xz-rectangle of
+/// [lo, hi], which does not contain the axis: the extremes are at its corners.
+fn angle_range32(lo: [f32; 3], hi: [f32; 3], w: f32, px: f32) -> (f32, f32) {
+    let mid = (0.5 * (lo[2] + hi[2])).atan2(0.5 * (lo[0] + hi[0]));
+    let corner = |x: f32, z: f32| wrap(z.atan2(x) - mid + PI, 2.0 * PI) - PI;
+    let d = [
+        corner(lo[0], lo[2]),
+        corner(lo[0], hi[2]),
+        corner(hi[0], lo[2]),
+        corner(hi[0], hi[2]),
+    ];
+    let (a, b) = (
+        d[0].min(d[1]).min(d[2].min(d[3])),
+        d[0].max(d[1]).max(d[2].max(d[3])),
+    );
+    let k = w / (2.0 * PI);
+    ((mid + a + PI) * k - 0.5 - px, (mid + b + PI) * k - 0.5 + px)
 }
 
 /// The largest sample differences along x and y over the patches the coordinates touch.

@@ -50,6 +50,15 @@ pub enum Carrier {
     /// A sphere, the grid an equirectangular map: column i at longitude
     /// −180° + (i + ½)·360°/W (atan2(z, x)), row j at latitude 90° − (j + ½)·180°/H.
     Sphere { centre: [f64; 3], radius: f64 },
+    /// A cylinder about the vertical axis through `base` (the quadric x² + z² = r² there): the
+    /// grid wraps around it, column i at angle −180° + (i + ½)·360°/W (atan2(z, x)), row j at
+    /// height `base.y + length·j/(H−1)`; beyond the ends the end rows' heights continue. Other
+    /// orientations: rotate the scene's camera and sun instead (the carrier stays upright).
+    Cylinder {
+        base: [f64; 3],
+        radius: f64,
+        length: f64,
+    },
 }
 
 /// Heights of a shape texture: inline, or a height map file (any format `relume-bake` reads for
@@ -143,6 +152,15 @@ impl TexturedSurface {
             Carrier::Sphere { centre, radius } => {
                 finite3(centre).map_err(|m| format!("carrier centre {m}"))?;
                 positive("carrier radius", *radius)?;
+            }
+            Carrier::Cylinder {
+                base,
+                radius,
+                length,
+            } => {
+                finite3(base).map_err(|m| format!("carrier base {m}"))?;
+                positive("carrier radius", *radius)?;
+                positive("carrier length", *length)?;
             }
         }
         self.heights.check().map_err(|m| format!("heights: {m}"))?;
