@@ -7,12 +7,9 @@ mod common;
 
 use proptest::prelude::*;
 use relume::freeform::field::Field;
-use relume::freeform::rmlrc::{camera_outside, cast, RmlrcParams};
-use relume::freeform::twin::{GpuField, View32};
-use relume::freeform::twin_cast::cast32;
+use relume::freeform::twin::GpuField;
 use relume::freeform::twin_texture::{range32, value32};
-use relume::freeform::{Bound, View};
-use relume::scene::freeform::{FreeformCamera, FreeformScene};
+use relume::scene::freeform::FreeformScene;
 use std::path::Path;
 
 fn scene_text(carrier: &str, seed: &[f64]) -> String {
@@ -87,27 +84,14 @@ proptest! {
     }
 }
 
-fn bundled(name: &str) -> (Field, FreeformCamera) {
-    let s = relume::load::freeform_scene(&Path::new("scenes/freeform").join(name)).unwrap();
-    (Field::compile(&s.shape).unwrap(), s.camera.unwrap())
-}
-
 #[test]
 fn gpu_returns_the_twin_and_the_twin_the_f64_caster_on_textured_scenes() {
     let Some(gpu) = common::gpu() else { return };
     let caster = relume::gpu::freeform_caster::FreeformCaster::new(&gpu).unwrap();
-    let params = RmlrcParams::default();
     for name in ["morph-grid.ron", "planet.ron", "column.ron"] {
-        let (field, camera) = bundled(name);
-        let view = View::new(&camera, 96, 72);
-        let v32 = View32::of(&view);
-        let gf = GpuField::upload(&field, view.eye).unwrap();
-        let prune = camera_outside(&field, &view, Bound::Affine);
-        let twin = cast32(&gf, &v32, params.top_level, params.refine, prune);
-        let gpu_hits = caster
-            .cast(&gpu, &gf, &v32, params.top_level, params.refine, prune)
-            .unwrap();
-        let (f64_hits, _) = cast(&field, &view, &params);
+        let (field, camera) = common::freeform::bundled(name);
+        let c = common::freeform::three_casts(&gpu, &caster, &field, &camera, (96, 72));
+        let (twin, gpu_hits, f64_hits) = (c.twin, c.gpu, c.f64);
         let (mut mask, mut hits, mut worst_depth, mut worst_normal, mut f64_diff, mut worst_f64) =
             (0usize, 0usize, 0f32, 0f32, 0usize, 0f64);
         let (mut outliers, mut f64_outliers) = (0usize, 0usize);

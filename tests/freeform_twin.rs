@@ -93,11 +93,6 @@ proptest! {
     }
 }
 
-fn bundled(name: &str) -> (Field, FreeformCamera) {
-    let s = FreeformScene::load(&Path::new("scenes/freeform").join(name)).unwrap();
-    (Field::compile(&s.shape).unwrap(), s.camera.unwrap())
-}
-
 /// Per pixel: GPU against twin (mask differences, worst depth and normal), twin against the f64
 /// caster (mask differences, on-another-surface count, worst depth).
 struct Agreement {
@@ -165,23 +160,15 @@ fn agreement(
 fn gpu_returns_the_twin_and_the_twin_the_f64_caster() {
     let Some(gpu) = common::gpu() else { return };
     let caster = relume::gpu::freeform_caster::FreeformCaster::new(&gpu).unwrap();
-    let params = RmlrcParams::default();
     for name in [
         "csg-holes.ron",
         "terrain-16.ron",
         "blobs-128.ron",
         "bench/terrain-256.ron",
     ] {
-        let (field, camera) = bundled(name);
-        let view = View::new(&camera, 96, 72);
-        let v32 = View32::of(&view);
-        let gf = GpuField::upload(&field, view.eye).unwrap();
-        let prune = camera_outside(&field, &view, Bound::Affine);
-        let twin = cast32(&gf, &v32, params.top_level, params.refine, prune);
-        let gpu_hits = caster
-            .cast(&gpu, &gf, &v32, params.top_level, params.refine, prune)
-            .unwrap();
-        let (f64_hits, _) = cast(&field, &view, &params);
+        let (field, camera) = common::freeform::bundled(name);
+        let c = common::freeform::three_casts(&gpu, &caster, &field, &camera, (96, 72));
+        let (twin, gpu_hits, f64_hits) = (c.twin, c.gpu, c.f64);
         let a = agreement(&twin, &gpu_hits, &f64_hits);
         eprintln!(
             "{name}: gpu vs twin: {} hit-mask differences, depth {:.2e} rel, normal {:.2e}, {} outliers of {} hits; twin vs f64: {} differences, depth {:.2e} rel ({} on another surface)",
@@ -224,7 +211,7 @@ fn a_search_split_into_rounds_returns_what_one_search_returns() {
         .unwrap()
         .with_pass_loops(4096);
     let params = RmlrcParams::default();
-    let (field, camera) = bundled("bench/terrain-64.ron");
+    let (field, camera) = common::freeform::bundled("bench/terrain-64.ron");
     let view = View::new(&camera, 96, 72);
     let v32 = View32::of(&view);
     let gf = GpuField::upload(&field, view.eye).unwrap();

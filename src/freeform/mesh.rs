@@ -109,14 +109,17 @@ pub fn polygonise_with_stats(field: &Field, params: &MeshParams) -> Result<(Mesh
     // One textured surface: its own sample grid is the better mesh (no creases to floor at).
     if let ([Op::Leaf(0)], [leaf]) = (field.ops.as_slice(), field.leaves.as_slice()) {
         if let Some(t) = leaf.texture {
-            let (mesh, k, spacing) =
-                super::mesh_texture::polygonise(&field.textures[t], params.tolerance)?;
+            let g = super::mesh_texture::polygonise(&field.textures[t], params.tolerance)?;
             let stats = MeshStats {
-                spacing,
+                spacing: g.spacing,
                 crease: true,
                 passes: 1,
-                subdivision: k,
+                subdivision: g.subdivision,
                 ..MeshStats::default()
+            };
+            let mesh = Mesh {
+                positions: g.positions,
+                triangles: g.triangles,
             };
             return Ok((mesh, stats));
         }

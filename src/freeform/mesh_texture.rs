@@ -23,7 +23,6 @@
 //! mesher's box does not cut it), a sphere whole. The mesh never coarsens below the grid: a coarser grid is the texture's
 //! `lod`. Output is deterministic (no threads).
 
-use super::mesh::Mesh;
 use super::texture::{CarrierGeom, Texture};
 use crate::error::{Error, Result};
 use std::f64::consts::PI;
@@ -33,9 +32,19 @@ pub const MAX_SUBDIVISION: u32 = 64;
 /// The most vertices a carrier-grid mesh may have.
 const MAX_VERTICES: u64 = 1 << 28;
 
-/// The mesh of `t` within `tolerance`, the subdivision `k` used and the largest distance
-/// between neighbouring vertices of the carrier (world units).
-pub fn polygonise(t: &Texture, tolerance: f64) -> Result<(Mesh, u32, f64)> {
+/// A carrier-grid mesh (the caller wraps it as `mesh::Mesh`).
+pub struct GridMesh {
+    pub positions: Vec<[f64; 3]>,
+    /// Counter-clockwise seen from outside (above the heights).
+    pub triangles: Vec<[u32; 3]>,
+    /// Points per sample cell and axis.
+    pub subdivision: u32,
+    /// The largest distance between neighbouring vertices of the carrier (world units).
+    pub spacing: f64,
+}
+
+/// The mesh of `t` within `tolerance`.
+pub fn polygonise(t: &Texture, tolerance: f64) -> Result<GridMesh> {
     let k = subdivision(t, tolerance)?;
     let (w, h) = (t.width, t.height);
     let sphere = matches!(t.carrier, CarrierGeom::Sphere { .. });
@@ -101,14 +110,12 @@ pub fn polygonise(t: &Texture, tolerance: f64) -> Result<(Mesh, u32, f64)> {
             radius, scale_y, ..
         } => (radius * 2.0 * PI / w as f64).max(1.0 / scale_y) / kf,
     };
-    Ok((
-        Mesh {
-            positions,
-            triangles,
-        },
-        k,
+    Ok(GridMesh {
+        positions,
+        triangles,
+        subdivision: k,
         spacing,
-    ))
+    })
 }
 
 /// The least `k` whose error bound (module header) is within `tolerance`.

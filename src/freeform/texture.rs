@@ -304,12 +304,8 @@ impl Texture {
                 radius,
                 scale_y,
             } => {
-                let r = sub(p, base);
-                (
-                    (r[0] * r[0] + r[2] * r[2]).sqrt() - radius,
-                    self.angle_x(r[2], r[0]),
-                    r[1] * scale_y,
-                )
+                let (r, axis) = axial(p, base);
+                (axis - radius, self.angle_x(r[2], r[0]), r[1] * scale_y)
             }
         }
     }
@@ -449,8 +445,7 @@ impl Texture {
                 radius,
                 scale_y,
             } => {
-                let r = sub(p, base);
-                let rho = (r[0] * r[0] + r[2] * r[2]).sqrt().max(radius * 1e-6);
+                let rho = axial(p, base).1.max(radius * 1e-6);
                 (rho * 2.0 * PI / self.width as f64).min(1.0 / scale_y)
             }
         }
@@ -592,15 +587,7 @@ impl Texture {
                     };
                     (xs, ys, grad)
                 };
-                // Slack for the angle arithmetic: a hundredth of a sample.
-                let pad = 0.01;
-                (
-                    dmin - radius,
-                    dmax - radius,
-                    (xs.0 - pad, xs.1 + pad),
-                    (ys.0 - pad, ys.1 + pad),
-                    grad,
-                )
+                curved(dmin - radius, dmax - radius, xs, ys, grad)
             }
             CarrierGeom::Cylinder {
                 base,
@@ -625,17 +612,35 @@ impl Texture {
                         sx * self.width as f64 / (2.0 * PI * dmin) + sy * scale_y,
                     )
                 };
-                let pad = 0.01;
-                (
-                    dmin - radius,
-                    dmax - radius,
-                    (xs.0 - pad, xs.1 + pad),
-                    (ys.0 - pad, ys.1 + pad),
-                    grad,
-                )
+                curved(dmin - radius, dmax - radius, xs, ys, grad)
             }
         }
     }
+}
+
+/// `p − base` and its distance from the vertical axis through `base`.
+fn axial(p: [f64; 3], base: [f64; 3]) -> ([f64; 3], f64) {
+    let r = sub(p, base);
+    (r, (r[0] * r[0] + r[2] * r[2]).sqrt())
+}
+
+/// A curved carrier's box coordinates, the sample ranges padded by a hundredth of a sample
+/// (slack for the angle arithmetic).
+fn curved(
+    dl: f64,
+    dh: f64,
+    xs: (f64, f64),
+    ys: (f64, f64),
+    grad: f64,
+) -> (f64, f64, (f64, f64), (f64, f64), f64) {
+    let pad = 0.01;
+    (
+        dl,
+        dh,
+        (xs.0 - pad, xs.1 + pad),
+        (ys.0 - pad, ys.1 + pad),
+        grad,
+    )
 }
 
 fn grid_map(w: usize, h: usize, heights: Vec<f32>) -> HeightMap {

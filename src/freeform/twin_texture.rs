@@ -350,7 +350,6 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
         ];
         let dmin = (near[0] * near[0] + near[1] * near[1]).sqrt() * (1.0 - KR);
         let dmax = (far[0] * far[0] + far[1] * far[1]).sqrt() * (1.0 + KR);
-        let rs = KR * radius + TINY;
         let px = 0.02 + 4.0 * APAD * w / (2.0 * PI);
         let py = 0.02 + KR * (lo_r[1].abs() + hi_r[1].abs()) * sy;
         let ys = (lo_r[1] * sy - py, hi_r[1] * sy + py);
@@ -361,14 +360,7 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
             let s = slopes(&r, xs, ys);
             (xs, (s[0] * w / (2.0 * PI * dmin) + s[1] * sy) * (1.0 + KR))
         };
-        (
-            dmin - radius - rs,
-            dmax - radius + rs,
-            xs,
-            ys,
-            grad,
-            [px, py],
-        )
+        curved32(dmin, dmax, radius, xs, ys, grad, [px, py])
     } else {
         let radius = r.f(11);
         let cs = KR * (norm1(c) + norm1(e) + norm1(o)) + TINY;
@@ -378,7 +370,6 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
         let far: [f32; 3] = std::array::from_fn(|k| lo_r[k].abs().max(hi_r[k].abs()));
         let dmin = norm(near) * (1.0 - KR);
         let dmax = norm(far) * (1.0 + KR);
-        let rs = KR * radius + TINY;
         let px = 0.02 + 4.0 * APAD * w / (2.0 * PI);
         let py = 0.02 + 4.0 * APAD * h / PI;
         let all_x = (-1.0 - px, w + px);
@@ -419,14 +410,7 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
             };
             (xs, ys, grad)
         };
-        (
-            dmin - radius - rs,
-            dmax - radius + rs,
-            xs,
-            ys,
-            grad,
-            [px, py],
-        )
+        curved32(dmin, dmax, radius, xs, ys, grad, [px, py])
     };
     let (hmax, hmin) = r.ranged(5, xs.0, xs.1, ys.0, ys.1);
     let hmag = hmax.abs().max(hmin.abs());
@@ -446,6 +430,22 @@ pub fn range32(words: &[u32], at: usize, lo: [f32; 3], hi: [f32; 3]) -> (f32, f3
         (-INF, INF)
     };
     (mip.0.max(lip.0), mip.1.min(lip.1))
+}
+
+/// A curved carrier's box coordinates: the distance range to the carrier's surface widened by
+/// 2⁻²⁰ of the radius, then as computed.
+#[allow(clippy::type_complexity)]
+fn curved32(
+    dmin: f32,
+    dmax: f32,
+    radius: f32,
+    xs: (f32, f32),
+    ys: (f32, f32),
+    grad: f32,
+    pad: [f32; 2],
+) -> (f32, f32, (f32, f32), (f32, f32), f32, [f32; 2]) {
+    let rs = KR * radius + TINY;
+    (dmin - radius - rs, dmax - radius + rs, xs, ys, grad, pad)
 }
 
 /// The continuous sample x range (padded by `px`) of atan2(z, x) over the xz-rectangle of

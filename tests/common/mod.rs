@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: run the real binaries, find bundled data.
 #![allow(dead_code)]
 
+pub mod freeform;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
