@@ -25,6 +25,7 @@ pub mod reference;
 pub mod rmlrc;
 pub mod shade;
 pub mod texture;
+pub mod texture_bounds;
 pub mod texture_cast;
 pub mod twin;
 pub mod twin_cast;

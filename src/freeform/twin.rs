@@ -145,7 +145,7 @@ impl GpuField {
         let records: Vec<u32> = field
             .textures
             .iter()
-            .map(|t| twin_texture::append(t, t.slope_mips(), eye, &mut textures))
+            .map(|t| twin_texture::append(t, eye, &mut textures))
             .collect();
         if textures.len() > MAX_TEXTURE_WORDS {
             return Err(Error::knob(format!(

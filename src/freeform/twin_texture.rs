@@ -30,7 +30,6 @@
 //! the pad, not bit for bit; on a plane they run the same operations.
 
 use super::texture::{CarrierGeom, Texture};
-use crate::heightmap::minmax_mipmap::MinMaxMipmap;
 use std::f32::consts::PI;
 
 const KR: f32 = 9.536_743e-7; // 2^-20
@@ -46,7 +45,8 @@ fn f(x: f64) -> u32 {
 }
 
 /// Append `t`'s record (eye-relative) to `words`; returns its offset.
-pub fn append(t: &Texture, slopes: [&MinMaxMipmap; 2], eye: [f64; 3], words: &mut Vec<u32>) -> u32 {
+pub fn append(t: &Texture, eye: [f64; 3], words: &mut Vec<u32>) -> u32 {
+    let slopes = t.slope_mips();
     let start = words.len();
     let levels = &t.mip.levels;
     let mut rec = vec![0u32; HEAD + 3 * levels.len()];
