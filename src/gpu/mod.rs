@@ -180,6 +180,7 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "corner_interpolate.wgsl",
     "direct_light.wgsl",
     "freeform.wgsl",
+    "freeform_affine.wgsl",
     "freeform_shade.wgsl",
     "freeform_texture.wgsl",
     "gather_compressed.wgsl",
