@@ -11,6 +11,7 @@ use relume::heightmap::HeightMap;
 use relume::terrain::accelerated_traversal::shadowed_accelerated;
 use relume::terrain::exact_traversal::{sample_bilinear, shadowed_exact, track_texels};
 use relume::terrain::generate::{generate, Shape};
+use relume::terrain::sweep::shadow_mask_sweep;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 use terrain_common::{random_map, Rng};
 
@@ -19,6 +20,8 @@ fn assert_equal_everywhere(map: &HeightMap, sun: &Sun) -> usize {
     let mip = MinMaxMipmap::build(map);
     let track = Track::new(sun, map.cell_size);
     let (_, max) = map.min_max();
+    let (swept, _) = shadow_mask_sweep(map, Some(&mip), &track);
+    let (swept_plain, _) = shadow_mask_sweep(map, None, &track);
     let mut shadowed = 0;
     for row in 0..map.height {
         for col in 0..map.width {
@@ -33,6 +36,17 @@ fn assert_equal_everywhere(map: &HeightMap, sun: &Sun) -> usize {
                 exact, fast,
                 "accelerated differs at pixel ({col}, {row}) of {}x{} sun {sun:?}",
                 map.width, map.height
+            );
+            assert_eq!(
+                exact,
+                swept[row * map.width + col],
+                "sweep differs at pixel ({col}, {row}) of {}x{} sun {sun:?}",
+                map.width,
+                map.height
+            );
+            assert_eq!(
+                swept[row * map.width + col],
+                swept_plain[row * map.width + col]
             );
             shadowed += exact as usize;
         }

@@ -140,20 +140,23 @@ pub fn run(map: &HeightMap, cfg: &TerrainConfig, progress: &dyn Progress) -> Res
                 timed_cpu(|| shadow_mask(m, sun, HardMethod::Exact, None, &Silent));
             let (fast, aw, ac) =
                 timed_cpu(|| shadow_mask(m, sun, HardMethod::Accelerated, Some(&mip), &Silent));
+            let (swept, sw, sc) =
+                timed_cpu(|| shadow_mask(m, sun, HardMethod::Sweep, Some(&mip), &Silent));
             let shadowed = exact.iter().filter(|s| **s).count() as f64 / pixels;
             let exact_label = format!("{size} {el}° exact");
             for (method, mask, wall, cpu) in [
                 (HardMethod::Exact, &exact, ew, ec),
                 (HardMethod::Accelerated, &fast, aw, ac),
+                (HardMethod::Sweep, &swept, sw, sc),
             ] {
-                let name = format!("{method:?}").to_lowercase();
+                let name = method.label();
                 let mut s = Setting::new(format!("{size} {el}° {name}"), format!("{name} {el}°"))
                     .default_if(method == HardMethod::default())
                     .knob("width", m.width)
                     .knob("height", m.height)
                     .knob("sun_elevation", el)
                     .knob("sun_azimuth", cfg.azimuth)
-                    .knob("method", name.as_str());
+                    .knob("method", name);
                 s.reference = method == HardMethod::Exact;
                 s.baseline = Some(exact_label.clone());
                 s.errors

@@ -5,6 +5,8 @@
 //! - [`minmax_mipmap`]: the min/max mipmap (in `heightmap`, the data layer, so that freeform
 //!   shape textures share it; stored by `crate::baked::mipmap`);
 //! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
+//! - [`sweep`]: hard shadows by a certified sweep (bounds along bands, witnesses, exact
+//!   traversal for the rest), equal to the exact answer;
 //! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
 //! - [`relief`]: whole-image shadow masks and shaded relief;
 //! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
@@ -21,6 +23,8 @@ pub use crate::heightmap::minmax_mipmap;
 pub mod relief;
 pub mod soft;
 pub mod sun;
+pub mod sweep;
+pub mod sweep_bound;
 
 pub use minmax_mipmap::MinMaxMipmap;
 pub use sun::{Sun, Track, TrackKind};

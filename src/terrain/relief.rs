@@ -6,21 +6,34 @@ use super::accelerated_traversal::shadowed_accelerated;
 use super::exact_traversal::shadowed_exact;
 use super::minmax_mipmap::MinMaxMipmap;
 use super::sun::{Sun, Track};
+use super::sweep::shadow_mask_sweep;
 use crate::error::{Error, Result};
 use crate::heightmap::HeightMap;
 use crate::progress::Progress;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// How hard shadows are computed. Both give the same mask; `Accelerated` is the fast one.
+/// How hard shadows are computed. All give the same mask.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum HardMethod {
     /// Every texel on the track (algorithm A1), stopping once the ray is above the map's maximum.
     Exact,
     /// Over the min/max mipmap (algorithm A2).
-    #[default]
     Accelerated,
+    /// A certified sweep along the sun's azimuth; undecided pixels by A2.
+    #[default]
+    Sweep,
+}
+
+impl HardMethod {
+    pub fn label(&self) -> &'static str {
+        match self {
+            HardMethod::Exact => "exact",
+            HardMethod::Accelerated => "accelerated",
+            HardMethod::Sweep => "sweep",
+        }
+    }
 }
 
 /// Shadow mask of `map` (row-major, `true` = in shadow). `mip` is used by `Accelerated` (built
@@ -35,12 +48,18 @@ pub fn shadow_mask(
     let track = Track::new(sun, map.cell_size);
     let built;
     let mip = match (method, mip) {
-        (HardMethod::Accelerated, None) => {
+        (HardMethod::Accelerated | HardMethod::Sweep, None) => {
             built = MinMaxMipmap::build(map);
             Some(&built)
         }
         (_, m) => m,
     };
+    if method == HardMethod::Sweep {
+        progress.begin("shadow", 0);
+        let (mask, _) = shadow_mask_sweep(map, mip, &track);
+        progress.finish();
+        return mask;
+    }
     let (_, max_height) = map.min_max();
     progress.begin("shadow", map.height as u64);
     let rows: Vec<Vec<bool>> = (0..map.height)

@@ -274,7 +274,7 @@ pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32
             "width": map.width, "height": map.height,
             "cell_size": map.cell_size, "height_scale": map.height_scale,
             "sun_azimuth": sun.azimuth_deg, "sun_elevation": sun.elevation_deg,
-            "method": match method { HardMethod::Exact => "exact", HardMethod::Accelerated => "accelerated" },
+            "method": method.label(),
             "shadowed_fraction": fraction,
             "seconds": seconds, "mpixels_per_second": mpix,
             "out": args.out.display().to_string(),
