@@ -5,8 +5,8 @@ CARGO    ?= cargo
 BAKE     := target/release/relume-bake
 PLAYER   := target/release/relume-player
 SUDO     := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth
-PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder
+APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth gdal-bin
+PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder rasterio
 export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
@@ -130,9 +130,9 @@ deps-apt:
 	fi
 
 deps-py:
-	@python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder" 2>/dev/null || { \
+	@python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio" 2>/dev/null || { \
 	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) && \
-	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder"; } || \
+	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio"; } || \
 	  { echo "error: cannot install the Python cross-check readers ($(PY_PKGS))" >&2; exit 1; }
 
 ## Coverage-guided fuzzing of every reader with AFL++ on stable Rust (docs/fuzzing.md): EXECS

@@ -232,6 +232,16 @@ pub fn heightmap_input(
     cell_size: Option<f64>,
     height_scale: Option<f64>,
 ) -> Result<HeightMap> {
+    Ok(heightmap_input_with_info(input, cell_size, height_scale)?.0)
+}
+
+/// [`heightmap_input`] with what the loader learnt about the file (its georeference and
+/// no-data texels).
+pub fn heightmap_input_with_info(
+    input: &Path,
+    cell_size: Option<f64>,
+    height_scale: Option<f64>,
+) -> Result<(HeightMap, crate::heightmap::HeightMapInfo)> {
     let is_pipeline = input
         .extension()
         .and_then(|e| e.to_str())
@@ -256,6 +266,5 @@ pub fn heightmap_input(
     if let Some(s) = height_scale {
         opts.height_scale = Some(s);
     }
-    let (map, _) = load_heightmap(&path, &opts)?;
-    Ok(map)
+    load_heightmap(&path, &opts)
 }

@@ -10,6 +10,7 @@
 //! No-data texels (NaN, ±∞, or the file's/knob's no-data value) follow [`NoDataPolicy`]: an error
 //! by default, or filled with the minimum valid height or with the nearest valid height.
 
+pub mod georef;
 pub mod minmax_mipmap;
 mod readers;
 
@@ -76,6 +77,12 @@ pub struct HeightMapInfo {
     pub cell_size_source: String,
     /// Width and height of the file's grid (before `downsample`).
     pub source_size: [usize; 2],
+    /// Where the grid lies (a GeoTIFF's georeference tags), for the loaded (downsampled) grid.
+    pub georef: Option<georef::GeoReference>,
+    /// Which texels of the loaded grid were no-data before the policy filled them (empty when
+    /// none; a downsampled texel is no-data when any of its source texels was).
+    #[serde(skip)]
+    pub nodata_mask: Vec<bool>,
 }
 
 /// Raw decoded samples before scaling and no-data handling.
@@ -87,6 +94,7 @@ pub(crate) struct RawGrid {
     pub sample: &'static str,
     pub nodata: Option<f64>,
     pub cell_size: Option<([f64; 2], &'static str)>,
+    pub georef: Option<georef::GeoReference>,
 }
 
 /// Load a height map, choosing the reader by extension (`.png`, `.jpg`/`.jpeg`, `.exr`,
@@ -162,8 +170,28 @@ pub fn load_heightmap(path: &Path, opts: &HeightMapOptions) -> Result<(HeightMap
         cell_size,
         height_scale,
     };
+    let mut nodata_mask = if nodata_count > 0 {
+        valid.iter().map(|v| !v).collect()
+    } else {
+        Vec::new()
+    };
+    let mut georef = raw.georef;
     if opts.downsample > 1 {
-        map = map.downsample(opts.downsample as usize);
+        let f = opts.downsample as usize;
+        map = map.downsample(f);
+        georef = georef.map(|g| g.downsampled(f));
+        if !nodata_mask.is_empty() {
+            let (w, h) = (map.width, map.height);
+            nodata_mask = (0..w * h)
+                .map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    (y * f..((y + 1) * f).min(raw.height)).any(|yy| {
+                        (x * f..((x + 1) * f).min(raw.width))
+                            .any(|xx| nodata_mask[yy * raw.width + xx])
+                    })
+                })
+                .collect();
+        }
     }
     let info = HeightMapInfo {
         format: raw.format.into(),
@@ -171,6 +199,8 @@ pub fn load_heightmap(path: &Path, opts: &HeightMapOptions) -> Result<(HeightMap
         nodata_count,
         cell_size_source: cell_size_source.into(),
         source_size: [raw.width, raw.height],
+        georef,
+        nodata_mask,
     };
     Ok((map, info))
 }

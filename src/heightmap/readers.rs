@@ -107,6 +107,7 @@ fn read_image(path: &Path) -> Result<RawGrid> {
         format,
         sample,
         nodata: None,
+        georef: None,
         cell_size: None,
     })
 }
@@ -208,6 +209,7 @@ fn read_exr(path: &Path) -> Result<RawGrid> {
         format: "exr",
         sample,
         nodata: None,
+        georef: None,
         cell_size: None,
     })
 }
@@ -257,6 +259,7 @@ fn read_tiff(path: &Path) -> Result<RawGrid> {
             .map(|s| [s[0], s[1]]),
         _ => None,
     };
+    let georef = super::georef::GeoReference::read(&mut dec);
     let data = dec.read_image().map_err(tiff_err)?;
     let (sample, values): (&'static str, Vec<f64>) = match data {
         DecodingResult::U8(v) => ("u8", v.into_iter().map(f64::from).collect()),
@@ -292,6 +295,7 @@ fn read_tiff(path: &Path) -> Result<RawGrid> {
         sample,
         nodata,
         cell_size,
+        georef,
     })
 }
 
@@ -356,6 +360,7 @@ fn read_raw(path: &Path, size: Option<[usize; 2]>) -> Result<RawGrid> {
         format: "raw-f32",
         sample: "f32",
         nodata: None,
+        georef: None,
         cell_size: None,
     })
 }

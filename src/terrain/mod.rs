@@ -10,6 +10,7 @@
 //! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
 //! - [`relief`]: whole-image shadow masks and shaded relief;
 //! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
+//! - [`solar`]: the sun's position from date, time and place (NREL SPA);
 //! - [`generate`]: synthetic height maps (stress maps and analytic shapes);
 //!
 //! Per-pixel kernels are plain loops over flat arrays (no recursion, no allocation) so that
@@ -22,6 +23,7 @@ pub mod hard_f32;
 pub use crate::heightmap::minmax_mipmap;
 pub mod relief;
 pub mod soft;
+pub mod solar;
 pub mod sun;
 pub mod sweep;
 pub mod sweep_bound;

@@ -5,6 +5,7 @@ mod compress;
 mod freeform;
 mod radiosity;
 mod study;
+mod sun_args;
 mod terrain;
 mod ui;
 

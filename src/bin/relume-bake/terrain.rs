@@ -1,11 +1,13 @@
 //! Terrain subcommands: `shadow` (hard relief shadows), `generate` (synthetic height maps) and
 //! `softshadow` (sun-disc soft shadows). Thin: load, call the library, write images atomically.
 
+use crate::sun_args::SunArgs;
 use crate::ui::Ui;
 use clap::{Args, ValueEnum};
 use relume::baked::images::{self, check_extension};
 use relume::error::exit;
-use relume::heightmap::HeightMap;
+use relume::heightmap::georef::{write_geotiff_f32, write_geotiff_u8};
+use relume::heightmap::{HeightMap, HeightMapInfo};
 use relume::progress::Progress;
 use relume::render::tonemap::linear_to_srgb8;
 use relume::terrain::generate::{generate, quantise_u16, Shape};
@@ -21,8 +23,13 @@ const SUN_HELP: &str = "\
 Sun convention: azimuth in degrees clockwise from north, where north is up the image (toward
 row 0) and east is toward the last column: 0 = sun in the north, 90 = east, 180 = south,
 270 = west. Elevation in degrees above the horizon (0 = on the horizon, 90 = zenith).
+Or --date (ISO 8601 with a zone) and a place: --lat/--lon, or the centre of a GeoTIFF with a
+geographic or UTM georeference; the sun then comes from NREL's SPA with refraction, its azimuth
+turned from true north to the grid's (the meridian convergence on UTM).
 Input: a height map (.png .jpg .exr .tif .raw) or a pipeline file (.ron), whose input and
-its knobs (cell size, height scale, no-data policy) are used.";
+its knobs (cell size, height scale, no-data policy) are used.
+A .tif output is a GeoTIFF with the input's georeference; no-data texels of the input are
+no-data there (mask: 128; lit fraction: -1) and are left out of the reported fractions.";
 
 /// Where the height map comes from and how to scale it.
 #[derive(Args, Clone)]
@@ -37,17 +44,6 @@ pub struct MapArgs {
     pub height_scale: Option<f64>,
 }
 
-/// The sun's direction.
-#[derive(Args, Clone)]
-pub struct SunArgs {
-    /// Degrees clockwise from north (0 = north = up the image, 90 = east)
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
-    pub sun_azimuth: f64,
-    /// Degrees above the horizon
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
-    pub sun_elevation: f64,
-}
-
 #[derive(Args)]
 #[command(after_help = SUN_HELP)]
 pub struct ShadowArgs {
@@ -58,8 +54,8 @@ pub struct ShadowArgs {
     /// Traversal method
     #[arg(long, value_enum, default_value_t = HardMethod::default())]
     pub method: HardMethod,
-    /// Shadow mask to write (.png: white = lit, black = shadow)
-    #[arg(long, value_name = "MASK.png")]
+    /// Shadow mask to write (.png or GeoTIFF .tif: 255 = lit, 0 = shadow, .tif 128 = no-data)
+    #[arg(long, value_name = "MASK.png|MASK.tif")]
     pub out: PathBuf,
     #[command(flatten)]
     pub relief: ReliefArgs,
@@ -159,8 +155,8 @@ pub struct SoftShadowArgs {
     /// Dynamic programming: intervals along the track (0 = as many as it needs)
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub intervals: u32,
-    /// Lit fraction to write: .png (16-bit, 65535 = fully lit) or .exr (f32)
-    #[arg(long, value_name = "LIT.png|LIT.exr")]
+    /// Lit fraction to write: .png (16-bit, 65535 = fully lit), .exr (f32) or GeoTIFF .tif (f32)
+    #[arg(long, value_name = "LIT.png|LIT.exr|LIT.tif")]
     pub out: PathBuf,
     #[command(flatten)]
     pub relief: ReliefArgs,
@@ -168,8 +164,8 @@ pub struct SoftShadowArgs {
 
 /// `relume-bake softshadow`.
 pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
-    let sun = Sun::new(args.sun.sun_azimuth, args.sun.sun_elevation)?;
-    check_extension(&args.out, &["png", "exr"])?;
+    args.sun.check()?;
+    check_extension(&args.out, &["png", "exr", "tif", "tiff"])?;
     args.relief.check()?;
     let method = match args.method {
         SoftMethodArg::Exhaustive => SoftMethod::Exhaustive,
@@ -187,12 +183,26 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
     };
     params.check()?;
     ui.begin("load", 0);
-    let map = load_map(&args.map)?;
+    let (map, info) = load_map(&args.map)?;
     ui.finish();
+    let (sun, sun_json) = args.sun.resolve(&map, &info)?;
     let t0 = Instant::now();
     let lit = soft_shadow_map(&map, &sun, &params, None, ui)?;
     let seconds = t0.elapsed().as_secs_f64();
-    if images::is_exr(&args.out) {
+    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
+    if is_tiff(&args.out) {
+        let v: Vec<f32> = (0..lit.len())
+            .map(|i| if nodata(i) { -1.0 } else { lit[i] })
+            .collect();
+        write_geotiff_f32(
+            &args.out,
+            map.width,
+            map.height,
+            &v,
+            info.georef.as_ref(),
+            Some(-1.0),
+        )?;
+    } else if images::is_exr(&args.out) {
         images::write_exr_gray(&args.out, map.width, map.height, &lit)?;
     } else {
         let px = lit
@@ -205,16 +215,18 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
         let shadow: Vec<f32> = lit.iter().map(|l| 1.0 - l).collect();
         args.relief.write(&map, &sun, &shadow)?;
     }
-    let n = lit.len() as f64;
-    let mean = lit.iter().map(|&l| l as f64).sum::<f64>() / n;
-    let penumbra = lit.iter().filter(|&&l| l > 0.0 && l < 1.0).count() as f64 / n;
-    let mpix = n / seconds.max(1e-9) / 1e6;
+    let valid = || (0..lit.len()).filter(|&i| !nodata(i)).map(|i| lit[i]);
+    let n = valid().count().max(1) as f64;
+    let mean = valid().map(|l| l as f64).sum::<f64>() / n;
+    let penumbra = valid().filter(|&l| l > 0.0 && l < 1.0).count() as f64 / n;
+    let mpix = lit.len() as f64 / seconds.max(1e-9) / 1e6;
     if json {
         print_json(&json!({
             "input": args.map.input.display().to_string(),
             "width": map.width, "height": map.height,
             "cell_size": map.cell_size, "height_scale": map.height_scale,
             "sun_azimuth": sun.azimuth_deg, "sun_elevation": sun.elevation_deg,
+            "sun": sun_json, "nodata_texels": info.nodata_count,
             "sun_radius": args.sun_radius, "planet_radius": args.planet_radius,
             "method": method.label(),
             "mean_lit": mean, "penumbra_fraction": penumbra,
@@ -239,8 +251,14 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
 }
 
 /// Load the input of a terrain command: a height map, or a pipeline's height-map input.
-pub fn load_map(args: &MapArgs) -> Result<HeightMap> {
-    relume::load::heightmap_input(&args.input, args.cell_size, args.height_scale)
+pub fn load_map(args: &MapArgs) -> Result<(HeightMap, HeightMapInfo)> {
+    relume::load::heightmap_input_with_info(&args.input, args.cell_size, args.height_scale)
+}
+
+fn is_tiff(path: &std::path::Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("tif") || e.eq_ignore_ascii_case("tiff"))
 }
 
 fn print_json(v: &serde_json::Value) {
@@ -249,24 +267,49 @@ fn print_json(v: &serde_json::Value) {
 
 /// `relume-bake shadow`.
 pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
-    let sun = Sun::new(args.sun.sun_azimuth, args.sun.sun_elevation)?;
-    check_extension(&args.out, &["png"])?;
+    args.sun.check()?;
+    check_extension(&args.out, &["png", "tif", "tiff"])?;
     args.relief.check()?;
     ui.begin("load", 0);
-    let map = load_map(&args.map)?;
+    let (map, info) = load_map(&args.map)?;
     ui.finish();
+    let (sun, sun_json) = args.sun.resolve(&map, &info)?;
     let method = args.method;
     let t0 = Instant::now();
     let mask = relief::shadow_mask(&map, &sun, method, None, ui);
     let seconds = t0.elapsed().as_secs_f64();
-    let shadowed = mask.iter().filter(|s| **s).count();
-    let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
-    images::write_png_gray8(&args.out, map.width, map.height, pixels)?;
+    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
+    let valid = (0..mask.len()).filter(|&i| !nodata(i)).count().max(1);
+    let shadowed = (0..mask.len()).filter(|&i| mask[i] && !nodata(i)).count();
+    if is_tiff(&args.out) {
+        let px: Vec<u8> = (0..mask.len())
+            .map(|i| {
+                if nodata(i) {
+                    128
+                } else if mask[i] {
+                    0
+                } else {
+                    255
+                }
+            })
+            .collect();
+        write_geotiff_u8(
+            &args.out,
+            map.width,
+            map.height,
+            &px,
+            info.georef.as_ref(),
+            Some(128),
+        )?;
+    } else {
+        let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
+        images::write_png_gray8(&args.out, map.width, map.height, pixels)?;
+    }
     if args.relief.shaded.is_some() {
         let shadow: Vec<f32> = mask.iter().map(|&s| s as u8 as f32).collect();
         args.relief.write(&map, &sun, &shadow)?;
     }
-    let fraction = shadowed as f64 / mask.len() as f64;
+    let fraction = shadowed as f64 / valid as f64;
     let mpix = mask.len() as f64 / seconds.max(1e-9) / 1e6;
     if json {
         print_json(&json!({
@@ -274,6 +317,7 @@ pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32
             "width": map.width, "height": map.height,
             "cell_size": map.cell_size, "height_scale": map.height_scale,
             "sun_azimuth": sun.azimuth_deg, "sun_elevation": sun.elevation_deg,
+            "sun": sun_json, "nodata_texels": info.nodata_count,
             "method": method.label(),
             "shadowed_fraction": fraction,
             "seconds": seconds, "mpixels_per_second": mpix,
