@@ -15,6 +15,7 @@ use relume::terrain::{MinMaxMipmap, Sun, Track};
 use std::time::Instant;
 use util::{env, load};
 
+#[allow(unused_imports)]
 mod util;
 
 /// Best wall time of `reps` runs.

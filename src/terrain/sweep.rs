@@ -435,7 +435,7 @@ pub fn witness(
     };
     let exit = |a: (f64, i64, f64, f64, i64, i64), c: i64| Track::exit_time(a.0, c, a.1, a.2);
     let (ta, tb) = (entry(major, line), exit(major, line));
-    if !(ta < tb) && line != major.4 {
+    if ta >= tb && line != major.4 {
         return false;
     }
     let (from, to) = if minor.1 == 0 {
@@ -451,7 +451,7 @@ pub fn witness(
         let t_in = entry(minor, c).max(ta).max(0.0);
         let t_out = exit(minor, c).min(tb);
         let start = c == minor.4 && line == major.4;
-        if !(t_in < t_out) && !start {
+        if t_in >= t_out && !start {
             continue;
         }
         let texel = if transposed { [line, c] } else { [c, line] };
