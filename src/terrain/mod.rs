@@ -7,6 +7,7 @@
 //! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
 //! - [`sweep`]: hard shadows by a certified sweep (bounds along bands, witnesses, exact
 //!   traversal for the rest), equal to the exact answer;
+//! - [`horizon`]: horizon angles for N azimuths by a line sweep with convex hulls;
 //! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
 //! - [`relief`]: whole-image shadow masks and shaded relief;
 //! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
@@ -20,6 +21,7 @@ pub mod accelerated_traversal;
 pub mod exact_traversal;
 pub mod generate;
 pub mod hard_f32;
+pub mod horizon;
 pub use crate::heightmap::minmax_mipmap;
 pub mod relief;
 pub mod soft;

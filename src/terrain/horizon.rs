@@ -1,0 +1,409 @@
+//! Horizon maps (docs/algorithms.md §4.4): for each of N azimuths, the elevation angle of the
+//! horizon at every texel, by a sweep along lines through pixel centres with an upper convex
+//! hull per line (after Timonen & Westerholm 2010), equal to the exact per-pixel horizon.
+//!
+//! **The horizon.** For pixel P and a track direction u, the horizon angle is
+//! `H(P) = atan(max_T (h(Q_T) − z_P) / (t_T · metres_per_t))` over the texels T of P's track
+//! with the exact traversal's samples ([`super::exact_traversal`]: the bilinear height at the
+//! transit midpoint). Then the exact hard-shadow test for a sun of that azimuth and elevation e
+//! is `e < H(P)` — the horizon map is the shadow test for every elevation at once.
+//!
+//! **Rational directions.** The N azimuths are texel-space directions (a, b) with small
+//! integers ([`directions`]): the track from P then passes through the centre of
+//! P′ = P + (a, b) after t = L = |(a, b)|, and every pixel's track is an integer translate of
+//! every other's, so the texels between P and P′ (the *period*) and their transit times are the
+//! same for all pixels. P's samples are its period's samples (its own texel with the half
+//! transit from the centre) and every sample of P′'s track except P′'s own start sample, which
+//! P's track crosses in full. A line of pixels P₀, P₀ + (a, b), … is processed from its far
+//! end: each pixel asks the hull of everything beyond its period for the tangent from
+//! (τ_P, z_P) (binary search: slopes to the vertices of an upper hull are unimodal from a point
+//! on its left), takes the maximum with its period's samples, then pushes its period (with
+//! its own texel's full transit) for the pixels behind it. O(period) per pixel and azimuth.
+//!
+//! The azimuths are close to, not exactly, uniform: within a fifth of the spacing (the actual
+//! ones are stored with the map). The samples are bit for bit the walk's up to the rounding
+//! of the translated times (a few ulps), so the sweep agrees with [`horizon_exact`] to
+//! ~1e-9°.
+
+use super::exact_traversal::texel_sample;
+use super::sun::{Track, TrackKind};
+use crate::heightmap::HeightMap;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// A horizon direction: a texel step (a columns east, b rows south) and its world azimuth.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Direction {
+    pub a: i64,
+    pub b: i64,
+    /// Degrees clockwise from north (up the image), in [0, 360).
+    pub azimuth_deg: f64,
+}
+
+impl Direction {
+    /// The world azimuth of texel step (a, b) on cells of `cell_size` metres.
+    pub fn new(a: i64, b: i64, cell_size: [f64; 2]) -> Direction {
+        let (east, north) = (a as f64 * cell_size[0], -(b as f64) * cell_size[1]);
+        Direction {
+            a,
+            b,
+            azimuth_deg: east.atan2(north).to_degrees().rem_euclid(360.0),
+        }
+    }
+
+    /// The track along this direction (geometry only: the elevation is left at 45°).
+    pub fn track(&self, cell_size: [f64; 2]) -> Track {
+        let l = (self.a as f64).hypot(self.b as f64);
+        let (ux, uy) = (self.a as f64 / l, self.b as f64 / l);
+        let sgn = |v: f64| (v > 0.0) as i64 - (v < 0.0) as i64;
+        let inv = |v: f64| if v == 0.0 { 0.0 } else { 1.0 / v };
+        let metres_per_t = (ux * cell_size[0]).hypot(uy * cell_size[1]);
+        Track {
+            kind: TrackKind::Ray,
+            ux,
+            uy,
+            step_x: sgn(ux),
+            step_y: sgn(uy),
+            inv_ux: inv(ux),
+            inv_uy: inv(uy),
+            metres_per_t,
+            tan_elevation: 1.0,
+            rise_per_t: metres_per_t,
+            elevation: std::f64::consts::FRAC_PI_4,
+        }
+    }
+}
+
+/// N directions close to N uniform azimuths (k·360/N, k = 0..N): for each, the texel step
+/// (a, b) with the smallest |a| + |b| (the cost per pixel) whose azimuth is within a fifth of the
+/// spacing, searching |a|, |b| ≤ 64, a and b coprime and not both odd (except the diagonals).
+/// Deterministic; distinct for N ≤ 360.
+pub fn directions(n: usize, cell_size: [f64; 2]) -> Vec<Direction> {
+    let spacing = 360.0 / n as f64;
+    (0..n)
+        .map(|k| {
+            let target = k as f64 * spacing;
+            let mut best: Option<(i64, f64, Direction)> = None;
+            for a in -64i64..=64 {
+                for b in -64i64..=64 {
+                    if (a, b) == (0, 0) || gcd(a.abs(), b.abs()) != 1 {
+                        continue;
+                    }
+                    // Both odd: the lines pass through texel corners, where a one-ulp tie
+                    // decides whether a side texel is touched, differently for different
+                    // pixels. The diagonals are exact ties (u_x = u_y bit for bit): kept.
+                    if (a + b) % 2 == 0 && a.abs() != b.abs() {
+                        continue;
+                    }
+                    let d = Direction::new(a, b, cell_size);
+                    let err = angle_between(d.azimuth_deg, target);
+                    let cost = a.abs() + b.abs();
+                    let better = match &best {
+                        None => true,
+                        Some((c, e, _)) => {
+                            let ok = err <= 0.2 * spacing;
+                            let was_ok = *e <= 0.2 * spacing;
+                            (ok && !was_ok) || (ok == was_ok && (cost, err) < (*c, *e) && ok)
+                                || (!ok && !was_ok && err < *e)
+                        }
+                    };
+                    if better {
+                        best = Some((cost, err, d));
+                    }
+                }
+            }
+            best.expect("some direction").2
+        })
+        .collect()
+}
+
+fn gcd(a: i64, b: i64) -> i64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// |a − b| on the circle, in degrees.
+pub fn angle_between(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(360.0);
+    d.min(360.0 - d)
+}
+
+/// The exact horizon angle (degrees) of pixel (col, row) along `track`: the walk of
+/// [`super::exact_traversal::shadowed_exact`], keeping the steepest sample, stopping once the
+/// map's maximum cannot be steeper. −90° is never returned: P's own texel always has a sample.
+pub fn horizon_exact(map: &HeightMap, track: &Track, col: usize, row: usize, max: f32) -> f64 {
+    let (w, h) = (map.width as i64, map.height as i64);
+    let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
+    let zp = map.heights[row * map.width + col] as f64;
+    let (mut ix, mut iy) = (col as i64, row as i64);
+    let mut t_in = 0.0f64;
+    let mut tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
+    let mut ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
+    let mut best = f64::NEG_INFINITY;
+    for _ in 0..(w + h) {
+        let t_out = tx.min(ty);
+        let (t_mid, hq) = texel_sample(map, track, [px, py], [ix, iy], t_in, t_out);
+        best = best.max((hq - zp) / t_mid);
+        let (step_x, step_y) = (tx <= ty, ty <= tx);
+        if step_x {
+            ix += track.step_x;
+            tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
+        }
+        if step_y {
+            iy += track.step_y;
+            ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
+        }
+        t_in = t_out;
+        if ix < 0 || iy < 0 || ix >= w || iy >= h || (max as f64 - zp) <= best * t_in {
+            break;
+        }
+    }
+    (best / track.metres_per_t).atan().to_degrees()
+}
+
+/// One texel of the period: offset from the pixel and transit times from its centre.
+#[derive(Clone, Copy, Debug)]
+struct PeriodTexel {
+    dx: i64,
+    dy: i64,
+    t_in: f64,
+    t_out: f64,
+}
+
+/// The walk from a pixel centre through its period, plus the texel of P′ = P + (a, b) (last).
+fn period(track: &Track, dir: &Direction) -> Vec<PeriodTexel> {
+    let (px, py) = (0.5, 0.5);
+    let (mut ix, mut iy) = (0i64, 0i64);
+    let mut t_in = 0.0;
+    let mut out = Vec::new();
+    loop {
+        let tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
+        let ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
+        let t_out = tx.min(ty);
+        out.push(PeriodTexel { dx: ix, dy: iy, t_in, t_out });
+        if (ix, iy) == (dir.a, dir.b) {
+            return out;
+        }
+        if tx <= ty {
+            ix += track.step_x;
+        }
+        if ty <= tx {
+            iy += track.step_y;
+        }
+        t_in = t_out;
+        assert!(out.len() as i64 <= 2 * (dir.a.abs() + dir.b.abs()) + 2);
+    }
+}
+
+/// Horizon angles (degrees, row-major) of every pixel along `dir`, by the line sweep.
+pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
+    let (w, h) = (map.width as i64, map.height as i64);
+    let track = dir.track(map.cell_size);
+    let per = period(&track, dir);
+    let k = per.len() - 1; // texels before P′'s; per[k] is P′'s texel seen from P
+    // Line length in t: P′'s centre is at t = |(a, b)| (u is (a, b) normalised).
+    let period_t = (dir.a as f64).hypot(dir.b as f64);
+    let out: Vec<AtomicU32> = (0..(w * h) as usize).map(|_| AtomicU32::new(0)).collect();
+    // Line starts: pixels P with P − (a, b) off the map.
+    let starts: Vec<(i64, i64)> = (0..h)
+        .flat_map(|r| (0..w).map(move |c| (c, r)))
+        .filter(|&(c, r)| {
+            let (c0, r0) = (c - dir.a, r - dir.b);
+            c0 < 0 || r0 < 0 || c0 >= w || r0 >= h
+        })
+        .collect();
+    let inside = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h;
+    starts.par_chunks(256).for_each(|chunk| {
+        let mut hull: Vec<(f64, f64)> = Vec::new();
+        let mut line: Vec<(i64, i64)> = Vec::new();
+        let mut samples: Vec<(f64, f64)> = Vec::with_capacity(k);
+        for &(c0, r0) in chunk {
+            line.clear();
+            let (mut c, mut r) = (c0, r0);
+            while inside(c, r) {
+                line.push((c, r));
+                c += dir.a;
+                r += dir.b;
+            }
+            hull.clear();
+            for (n, &(c, r)) in line.iter().enumerate().rev() {
+                let tau = n as f64 * period_t;
+                let p = [c as f64 + 0.5, r as f64 + 0.5];
+                let zp = map.heights[(r * w + c) as usize] as f64;
+                // The period's samples beyond the own texel (global τ, height).
+                samples.clear();
+                for t in &per[1..k] {
+                    let (x, y) = (c + t.dx, r + t.dy);
+                    if !inside(x, y) {
+                        break;
+                    }
+                    let (tm, hq) = texel_sample(map, &track, p, [x, y], t.t_in, t.t_out);
+                    samples.push((tau + tm, hq));
+                }
+                // Own texel, half transit.
+                let t0 = per[0];
+                let (tm0, h0) = texel_sample(map, &track, p, [c, r], 0.0, t0.t_out);
+                let mut best = (h0 - zp) / tm0;
+                for &(ts, hs) in &samples {
+                    best = best.max((hs - zp) / (ts - tau));
+                }
+                if let Some(s) = tangent(&hull, tau, zp) {
+                    best = best.max(s);
+                }
+                let deg = (best / track.metres_per_t).atan().to_degrees() as f32;
+                out[(r * w + c) as usize].store(deg.to_bits(), Ordering::Relaxed);
+                // Push this period for the pixels behind: samples in decreasing τ, then the
+                // own texel crossed in full by the previous pixel's track.
+                for &s in samples.iter().rev() {
+                    push(&mut hull, s);
+                }
+                let full = per[k];
+                let prev = [p[0] - dir.a as f64, p[1] - dir.b as f64];
+                let (tm, hq) = texel_sample(map, &track, prev, [c, r], full.t_in, full.t_out);
+                push(&mut hull, (tau - period_t + tm, hq));
+            }
+        }
+    });
+    out.into_iter().map(|v| f32::from_bits(v.into_inner())).collect()
+}
+
+/// Push a point left of every hull point onto the upper hull (the last element is leftmost).
+fn push(hull: &mut Vec<(f64, f64)>, q: (f64, f64)) {
+    while hull.len() >= 2 {
+        let a = hull[hull.len() - 1];
+        let b = hull[hull.len() - 2];
+        // a is not above the segment q–b: it can never be a tangent point from the left.
+        if (a.1 - q.1) * (b.0 - q.0) <= (b.1 - q.1) * (a.0 - q.0) {
+            hull.pop();
+        } else {
+            break;
+        }
+    }
+    hull.push(q);
+}
+
+/// The steepest slope from (tau, z) to the hull's vertices (all to its right), by binary
+/// search over the unimodal slopes; None for an empty hull.
+fn tangent(hull: &[(f64, f64)], tau: f64, z: f64) -> Option<f64> {
+    if hull.is_empty() {
+        return None;
+    }
+    let slope = |i: usize| (hull[i].1 - z) / (hull[i].0 - tau);
+    // Index 0 is rightmost; slopes rise from the left end (last) to the tangent, then fall.
+    let (mut lo, mut hi) = (0usize, hull.len() - 1);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if slope(mid) >= slope(mid + 1) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    Some(slope(lo))
+}
+
+/// Horizon angles for N directions, quantised to u16: angle = −90° + v·(180°/65535), an error
+/// of at most 0.0014° (half a step).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HorizonMap {
+    pub width: usize,
+    pub height: usize,
+    /// Sorted by azimuth.
+    pub directions: Vec<Direction>,
+    /// One row-major plane per direction.
+    pub angles: Vec<Vec<u16>>,
+}
+
+/// Degrees per quantisation step of [`HorizonMap`].
+pub const STEP_DEG: f64 = 180.0 / 65535.0;
+
+/// Quantise a horizon angle in degrees (clamped to [−90, 90]).
+pub fn encode(deg: f64) -> u16 {
+    ((deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG).round() as u16
+}
+
+/// The angle in degrees of a quantised value.
+pub fn decode(v: u16) -> f64 {
+    -90.0 + v as f64 * STEP_DEG
+}
+
+impl HorizonMap {
+    /// The horizon map of `map` for `n` directions ([`directions`]), one sweep per direction.
+    pub fn build(map: &HeightMap, n: usize) -> HorizonMap {
+        let directions = directions(n, map.cell_size);
+        let angles = directions
+            .iter()
+            .map(|d| horizon_sweep(map, d).iter().map(|&a| encode(a as f64)).collect())
+            .collect();
+        HorizonMap {
+            width: map.width,
+            height: map.height,
+            directions,
+            angles,
+        }
+    }
+
+    /// The two stored directions around `azimuth` and the weight of the second (linear in
+    /// azimuth, on the circle).
+    fn bracket(&self, azimuth: f64) -> (usize, usize, f64) {
+        let n = self.directions.len();
+        let az = azimuth.rem_euclid(360.0);
+        let k1 = self.directions.iter().position(|d| d.azimuth_deg > az).unwrap_or(0);
+        let k0 = (k1 + n - 1) % n;
+        let (a0, a1) = (self.directions[k0].azimuth_deg, self.directions[k1].azimuth_deg);
+        let span = (a1 - a0).rem_euclid(360.0);
+        let w = if span == 0.0 { 0.0 } else { (az - a0).rem_euclid(360.0) / span };
+        (k0, k1, w)
+    }
+
+    /// Hard shadows for any sun in O(1) per pixel: shadowed when the elevation is below the
+    /// horizon interpolated between the two stored azimuths around the sun's.
+    pub fn shadow_mask(&self, sun: &super::sun::Sun) -> Vec<bool> {
+        let n = self.width * self.height;
+        if sun.elevation_deg >= 90.0 {
+            return vec![false; n];
+        }
+        if sun.elevation_deg <= 0.0 {
+            return vec![true; n];
+        }
+        let (k0, k1, w) = self.bracket(sun.azimuth_deg);
+        let (p0, p1) = (&self.angles[k0], &self.angles[k1]);
+        (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let h = decode(p0[i]) * (1.0 - w) + decode(p1[i]) * w;
+                sun.elevation_deg < h
+            })
+            .collect()
+    }
+
+    /// The sky-view factor of a horizontal surface: the part of the sky hemisphere's
+    /// projected area above the horizon, Σ_k w_k (1 − sin max(H_k, 0)), each direction weighted
+    /// by half the azimuth gap to its neighbours (1 on flat ground; 1 − sin H under a uniform
+    /// horizon H).
+    pub fn sky_view(&self) -> Vec<f32> {
+        let n = self.directions.len();
+        let weights: Vec<f64> = (0..n)
+            .map(|k| {
+                let prev = self.directions[(k + n - 1) % n].azimuth_deg;
+                let next = self.directions[(k + 1) % n].azimuth_deg;
+                let gap = (next - prev).rem_euclid(360.0);
+                let gap = if n == 1 { 720.0 } else { gap };
+                0.5 * gap / 360.0
+            })
+            .collect();
+        (0..self.width * self.height)
+            .into_par_iter()
+            .map(|i| {
+                let mut v = 0.0;
+                for (k, w) in weights.iter().enumerate() {
+                    v += w * (1.0 - decode(self.angles[k][i]).max(0.0).to_radians().sin());
+                }
+                v as f32
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,132 @@
+//! Horizon maps: the line sweep equals the exact per-pixel horizon on every pixel (random maps,
+//! every direction of N = 4 … 64, anisotropic cells), analytic horizons (a wall, a tilted
+//! plane), the sky-view factor of flat ground, and hard shadows from horizon maps against the
+//! exact mask.
+
+mod terrain_common;
+
+use proptest::prelude::*;
+use relume::heightmap::HeightMap;
+use relume::terrain::horizon::{directions, horizon_exact, horizon_sweep, Direction};
+use terrain_common::random_map;
+
+/// The largest |sweep − exact| in degrees over every pixel.
+fn worst(map: &HeightMap, dir: &Direction) -> f64 {
+    let sweep = horizon_sweep(map, dir);
+    let track = dir.track(map.cell_size);
+    let (_, max) = map.min_max();
+    let mut worst = 0.0f64;
+    for row in 0..map.height {
+        for col in 0..map.width {
+            let e = horizon_exact(map, &track, col, row, max);
+            let s = sweep[row * map.width + col] as f64;
+            worst = worst.max((e - s).abs());
+        }
+    }
+    worst
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    #[test]
+    fn sweep_equals_exact_on_random_maps(
+        w in 1usize..24, h in 1usize..24, seed in any::<u64>(),
+        n in prop::sample::select(vec![4usize, 8, 16, 64]), k in 0usize..64,
+        cell in prop::sample::select(vec![[1.0, 1.0], [30.0, 30.0], [1.0, 3.0]]),
+    ) {
+        let map = random_map(w, h, seed, cell, 20.0);
+        let dirs = directions(n, cell);
+        let dir = dirs[k % n];
+        // f32 storage of the angle: 90° has an ulp of 7.6e-6°.
+        let e = worst(&map, &dir);
+        prop_assert!(e < 2e-5, "{w}x{h} dir {dir:?}: {e}°");
+    }
+}
+
+#[test]
+fn directions_are_near_uniform_and_distinct() {
+    for n in [4usize, 8, 16, 64, 128] {
+        let dirs = directions(n, [1.0, 1.0]);
+        for (k, d) in dirs.iter().enumerate() {
+            let target = k as f64 * 360.0 / n as f64;
+            let err = relume::terrain::horizon::angle_between(d.azimuth_deg, target);
+            assert!(err <= 0.2 * 360.0 / n as f64 + 1e-9, "n {n} k {k}: {d:?}");
+        }
+        for w in dirs.windows(2) {
+            assert!(w[0].azimuth_deg < w[1].azimuth_deg, "{:?}", w);
+        }
+    }
+    // Axis-aligned ones are single steps: north is up the image (row −1).
+    let d = directions(4, [1.0, 1.0]);
+    assert_eq!((d[0].a, d[0].b, d[1].a, d[1].b), (0, -1, 1, 0));
+}
+
+#[test]
+fn a_wall_and_a_tilted_plane_have_their_analytic_horizons() {
+    // A 10 m wall in column 30 of flat ground, 2 m cells: looking east from column c the wall
+    // texel's sample is its centre, 2·(30 − c) m away.
+    let (w, h) = (40, 5);
+    let mut hs = vec![0.0f32; w * h];
+    for r in 0..h {
+        hs[r * w + 30] = 10.0;
+    }
+    let map = HeightMap::new(w, h, hs, [2.0, 2.0]);
+    let east = Direction::new(1, 0, [2.0, 2.0]);
+    let sweep = horizon_sweep(&map, &east);
+    for c in 0..30 {
+        let want = (10.0f64 / (2.0 * (30 - c) as f64)).atan().to_degrees();
+        let got = sweep[2 * w + c] as f64;
+        assert!((got - want).abs() < 1e-5, "column {c}: {got} vs {want}");
+    }
+    // A plane rising east with slope 0.3 (bilinear is exact on it): the horizon is atan(0.3)
+    // looking east and −atan(0.3) looking west, away from the borders; north-east, the slope
+    // along the direction.
+    let (w, h) = (32, 32);
+    let hs = (0..w * h).map(|i| 0.3 * (i % w) as f32 * 5.0).collect();
+    let map = HeightMap::new(w, h, hs, [5.0, 5.0]);
+    for (a, b, slope) in [(1, 0, 0.3), (-1, 0, -0.3), (1, -1, 0.3 / 2f64.sqrt()), (2, 1, 0.3 * 2.0 / 5f64.sqrt())] {
+        let d = Direction::new(a, b, [5.0, 5.0]);
+        let sweep = horizon_sweep(&map, &d);
+        let want = slope.atan().to_degrees();
+        for r in 4..28 {
+            for c in 4..28 {
+                let got = sweep[r * w + c] as f64;
+                assert!((got - want).abs() < 1e-4, "({a},{b}) at ({c},{r}): {got} vs {want}");
+            }
+        }
+    }
+}
+
+
+#[test]
+fn sky_view_and_shadows_from_the_horizon_map() {
+    use relume::terrain::horizon::{HorizonMap, STEP_DEG};
+    use relume::terrain::{relief::shadow_mask, relief::HardMethod, Sun};
+    // Flat ground sees the whole sky; a pit of depth d and radius R (here: the centre of a
+    // 9-texel-wide square well) sees less.
+    let flat = HeightMap::new(16, 16, vec![0.0; 256], [1.0, 1.0]);
+    let hm = HorizonMap::build(&flat, 16);
+    assert!(hm.sky_view().iter().all(|&v| (v - 1.0).abs() < 1e-6));
+    // Quantisation: at most half a step from the sweep's angle.
+    let map = random_map(40, 30, 7, [2.0, 2.0], 30.0);
+    let hm = HorizonMap::build(&map, 32);
+    for (d, plane) in hm.directions.iter().zip(&hm.angles) {
+        let sweep = horizon_sweep(&map, d);
+        for (q, s) in plane.iter().zip(&sweep) {
+            assert!((relume::terrain::horizon::decode(*q) - *s as f64).abs() <= 0.5 * STEP_DEG + 1e-9);
+        }
+    }
+    // At a stored azimuth the horizon test is the exact test, up to the quantisation and
+    // ties: the masks agree on all but a few pixels. (Not on the diagonals: there the sun's
+    // sin/cos track is one ulp off the diagonal and touches corner texels the exact diagonal
+    // steps over, docs/algorithms.md §4.4.)
+    for (k, el) in [(3usize, 10.0), (8, 25.0), (21, 5.0), (30, 2.0)] {
+        let d = hm.directions[k];
+        assert_ne!(d.a.abs(), d.b.abs());
+        let sun = Sun::new(d.azimuth_deg, el).unwrap();
+        let exact = shadow_mask(&map, &sun, HardMethod::Exact, None, &relume::progress::Silent);
+        let fast = hm.shadow_mask(&sun);
+        let differ = exact.iter().zip(&fast).filter(|(a, b)| a != b).count();
+        assert!(differ <= 2, "direction {k}, {el}°: {differ} of {} differ", exact.len());
+    }
+}
