@@ -261,15 +261,15 @@ fn compression_quick_sweeps_reorder_split_and_encodings() {
 }
 
 #[test]
-fn terrain_quick_accelerated_equals_exact_and_report_is_thread_independent() {
+fn terrain_quick_accelerated_and_sweep_equal_exact_and_report_is_thread_independent() {
     let dir = tempfile::tempdir().unwrap();
     let j = study(dir.path(), &["terrain", "-j", "1"]);
     check_numbers(&j);
     let h = sweep(&j, "terrain_hard_shadows");
     assert_eq!(
         settings(h).len(),
-        2 * 2 * 2,
-        "2 sizes x 2 elevations x 2 methods"
+        2 * 2 * 3,
+        "2 sizes x 2 elevations x 3 methods (exact, accelerated, sweep)"
     );
     for s in settings(h) {
         assert_eq!(

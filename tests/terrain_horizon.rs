@@ -84,19 +84,26 @@ fn a_wall_and_a_tilted_plane_have_their_analytic_horizons() {
     let (w, h) = (32, 32);
     let hs = (0..w * h).map(|i| 0.3 * (i % w) as f32 * 5.0).collect();
     let map = HeightMap::new(w, h, hs, [5.0, 5.0]);
-    for (a, b, slope) in [(1, 0, 0.3), (-1, 0, -0.3), (1, -1, 0.3 / 2f64.sqrt()), (2, 1, 0.3 * 2.0 / 5f64.sqrt())] {
+    for (a, b, slope) in [
+        (1, 0, 0.3),
+        (-1, 0, -0.3),
+        (1, -1, 0.3 / 2f64.sqrt()),
+        (2, 1, 0.3 * 2.0 / 5f64.sqrt()),
+    ] {
         let d = Direction::new(a, b, [5.0, 5.0]);
         let sweep = horizon_sweep(&map, &d);
         let want = slope.atan().to_degrees();
         for r in 4..28 {
             for c in 4..28 {
                 let got = sweep[r * w + c] as f64;
-                assert!((got - want).abs() < 1e-4, "({a},{b}) at ({c},{r}): {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 1e-4,
+                    "({a},{b}) at ({c},{r}): {got} vs {want}"
+                );
             }
         }
     }
 }
-
 
 #[test]
 fn sky_view_and_shadows_from_the_horizon_map() {
@@ -113,7 +120,9 @@ fn sky_view_and_shadows_from_the_horizon_map() {
     for (d, plane) in hm.directions.iter().zip(&hm.angles) {
         let sweep = horizon_sweep(&map, d);
         for (q, s) in plane.iter().zip(&sweep) {
-            assert!((relume::terrain::horizon::decode(*q) - *s as f64).abs() <= 0.5 * STEP_DEG + 1e-9);
+            assert!(
+                (relume::terrain::horizon::decode(*q) - *s as f64).abs() <= 0.5 * STEP_DEG + 1e-9
+            );
         }
     }
     // At a stored azimuth the horizon test is the exact test, up to the quantisation and
@@ -124,9 +133,19 @@ fn sky_view_and_shadows_from_the_horizon_map() {
         let d = hm.directions[k];
         assert_ne!(d.a.abs(), d.b.abs());
         let sun = Sun::new(d.azimuth_deg, el).unwrap();
-        let exact = shadow_mask(&map, &sun, HardMethod::Exact, None, &relume::progress::Silent);
+        let exact = shadow_mask(
+            &map,
+            &sun,
+            HardMethod::Exact,
+            None,
+            &relume::progress::Silent,
+        );
         let fast = hm.shadow_mask(&sun);
         let differ = exact.iter().zip(&fast).filter(|(a, b)| a != b).count();
-        assert!(differ <= 2, "direction {k}, {el}°: {differ} of {} differ", exact.len());
+        assert!(
+            differ <= 2,
+            "direction {k}, {el}°: {differ} of {} differ",
+            exact.len()
+        );
     }
 }

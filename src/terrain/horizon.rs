@@ -103,7 +103,8 @@ pub fn directions(n: usize, cell_size: [f64; 2]) -> Vec<Direction> {
                         Some((c, e, _)) => {
                             let ok = err <= 0.2 * spacing;
                             let was_ok = *e <= 0.2 * spacing;
-                            (ok && !was_ok) || (ok == was_ok && (cost, err) < (*c, *e) && ok)
+                            (ok && !was_ok)
+                                || (ok == was_ok && (cost, err) < (*c, *e) && ok)
                                 || (!ok && !was_ok && err < *e)
                         }
                     };
@@ -183,7 +184,12 @@ fn period(track: &Track, dir: &Direction) -> Vec<PeriodTexel> {
         let tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
         let ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
         let t_out = tx.min(ty);
-        out.push(PeriodTexel { dx: ix, dy: iy, t_in, t_out });
+        out.push(PeriodTexel {
+            dx: ix,
+            dy: iy,
+            t_in,
+            t_out,
+        });
         if (ix, iy) == (dir.a, dir.b) {
             return out;
         }
@@ -204,7 +210,7 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
     let track = dir.track(map.cell_size);
     let per = period(&track, dir);
     let k = per.len() - 1; // texels before P′'s; per[k] is P′'s texel seen from P
-    // Line length in t: P′'s centre is at t = |(a, b)| (u is (a, b) normalised).
+                           // Line length in t: P′'s centre is at t = |(a, b)| (u is (a, b) normalised).
     let period_t = (dir.a as f64).hypot(dir.b as f64);
     let out: Vec<AtomicU32> = (0..(w * h) as usize).map(|_| AtomicU32::new(0)).collect();
     // Line starts: pixels P with P − (a, b) off the map.
@@ -267,7 +273,9 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
             }
         }
     });
-    out.into_iter().map(|v| f32::from_bits(v.into_inner())).collect()
+    out.into_iter()
+        .map(|v| f32::from_bits(v.into_inner()))
+        .collect()
 }
 
 /// Push a point left of every hull point onto the upper hull (the last element is leftmost).
@@ -336,7 +344,12 @@ impl HorizonMap {
         let directions = directions(n, map.cell_size);
         let angles = directions
             .iter()
-            .map(|d| horizon_sweep(map, d).iter().map(|&a| encode(a as f64)).collect())
+            .map(|d| {
+                horizon_sweep(map, d)
+                    .iter()
+                    .map(|&a| encode(a as f64))
+                    .collect()
+            })
             .collect();
         HorizonMap {
             width: map.width,
@@ -351,11 +364,22 @@ impl HorizonMap {
     fn bracket(&self, azimuth: f64) -> (usize, usize, f64) {
         let n = self.directions.len();
         let az = azimuth.rem_euclid(360.0);
-        let k1 = self.directions.iter().position(|d| d.azimuth_deg > az).unwrap_or(0);
+        let k1 = self
+            .directions
+            .iter()
+            .position(|d| d.azimuth_deg > az)
+            .unwrap_or(0);
         let k0 = (k1 + n - 1) % n;
-        let (a0, a1) = (self.directions[k0].azimuth_deg, self.directions[k1].azimuth_deg);
+        let (a0, a1) = (
+            self.directions[k0].azimuth_deg,
+            self.directions[k1].azimuth_deg,
+        );
         let span = (a1 - a0).rem_euclid(360.0);
-        let w = if span == 0.0 { 0.0 } else { (az - a0).rem_euclid(360.0) / span };
+        let w = if span == 0.0 {
+            0.0
+        } else {
+            (az - a0).rem_euclid(360.0) / span
+        };
         (k0, k1, w)
     }
 

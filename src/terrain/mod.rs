@@ -12,6 +12,7 @@
 //! - [`relief`]: whole-image shadow masks and shaded relief;
 //! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
 //! - [`solar`]: the sun's position from date, time and place (NREL SPA);
+//! - [`sunlight`]: hours of direct sun (and clear-sky insolation) over a day from horizon maps;
 //! - [`generate`]: synthetic height maps (stress maps and analytic shapes);
 //!
 //! Per-pixel kernels are plain loops over flat arrays (no recursion, no allocation) so that
@@ -27,6 +28,7 @@ pub mod relief;
 pub mod soft;
 pub mod solar;
 pub mod sun;
+pub mod sunlight;
 pub mod sweep;
 pub mod sweep_bound;
 

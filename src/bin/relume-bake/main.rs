@@ -3,6 +3,7 @@
 
 mod compress;
 mod freeform;
+mod horizon;
 mod radiosity;
 mod study;
 mod sun_args;
@@ -93,6 +94,10 @@ enum Command {
     /// Hard relief shadows of a height map for one sun: shadow mask and shaded relief (PNG)
     #[command(after_help = EXIT_CODES)]
     Shadow(terrain::ShadowArgs),
+    /// Horizon angles for N azimuths and the sky-view factor of a height map (GeoTIFF)
+    Horizon(horizon::HorizonArgs),
+    /// Hours of direct sun over a day (and clear-sky direct insolation) of a height map
+    Sunlight(horizon::SunlightArgs),
     /// Soft shadows of the sun's disc (penumbrae, curved planets): lit fraction and shaded relief
     #[command(after_help = EXIT_CODES)]
     Softshadow(terrain::SoftShadowArgs),
@@ -287,6 +292,8 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         Command::Study(a) => study::run(a, ui, json, cli.global.quiet),
         Command::Shadow(a) => terrain::shadow(a, ui, cli.global.quiet, json),
         Command::Softshadow(a) => terrain::softshadow(a, ui, cli.global.quiet, json),
+        Command::Horizon(a) => horizon::horizon(a, ui, cli.global.quiet, json),
+        Command::Sunlight(a) => horizon::sunlight_cmd(a, ui, cli.global.quiet, json),
         Command::Generate(a) => terrain::generate_cmd(a, cli.global.quiet, json),
         Command::Load { file, knobs } => {
             let loaded = load_any(

@@ -1,0 +1,121 @@
+//! Horizon maps (issue 14, item 2) on Puget Sound: the wall time of `HorizonMap::build` for N
+//! directions at 1K/2K/4K; its accuracy against the exact per-pixel horizon on a subsample
+//! (every 16th row and column at 4K, every 8th below); the cost per direction (texels per
+//! period); and hard shadows from the map for suns between its azimuths against the exact mask
+//! (the certified sweep, equal to the exact traversal on every pixel).
+//!
+//! `cargo bench --bench terrain_horizon` (env: RELUME_BENCH_SIZES, default "1024,2048,4096";
+//! RELUME_BENCH_DIRECTIONS, default "16,32,64").
+
+use rayon::prelude::*;
+use relume::terrain::horizon::{decode, horizon_exact, HorizonMap};
+use relume::terrain::relief::{shadow_mask, HardMethod};
+use relume::terrain::Sun;
+use std::time::Instant;
+use util::{env, load};
+
+#[allow(unused_imports)]
+mod util;
+
+fn list(name: &str, default: &str) -> Vec<usize> {
+    env::<String>(name, default.into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect()
+}
+
+fn main() {
+    let full = load("puget-sound.ron");
+    let sizes = list("RELUME_BENCH_SIZES", "1024,2048,4096");
+    let counts = list("RELUME_BENCH_DIRECTIONS", "16,32,64");
+    println!("## Horizon maps, Puget Sound\n");
+    println!(
+        "{} threads, wall time of one build (shared machine).\n",
+        rayon::current_num_threads()
+    );
+    println!("| size | directions | build | per direction | mean texels per period | pixels checked | within 0.01° | max error |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut kept = None;
+    for &n in &sizes {
+        let map = full.downsample(4096 / n);
+        let (_, max) = map.min_max();
+        for &k in &counts {
+            let t = Instant::now();
+            let hm = HorizonMap::build(&map, k);
+            let secs = t.elapsed().as_secs_f64();
+            let stride = if n >= 4096 { 16 } else { 8 };
+            let pixels: Vec<(usize, usize)> = (0..map.height)
+                .step_by(stride)
+                .flat_map(|r| (0..map.width).step_by(stride).map(move |c| (c, r)))
+                .collect();
+            let (ok, worst, total) = hm
+                .directions
+                .par_iter()
+                .zip(&hm.angles)
+                .map(|(d, plane)| {
+                    let track = d.track(map.cell_size);
+                    let mut acc = (0usize, 0.0f64, 0usize);
+                    for &(c, r) in &pixels {
+                        let e = horizon_exact(&map, &track, c, r, max);
+                        let err = (decode(plane[r * map.width + c]) - e).abs();
+                        acc.0 += (err <= 0.01) as usize;
+                        acc.1 = acc.1.max(err);
+                        acc.2 += 1;
+                    }
+                    acc
+                })
+                .reduce(|| (0, 0.0, 0), |a, b| (a.0 + b.0, a.1.max(b.1), a.2 + b.2));
+            let period: f64 = hm
+                .directions
+                .iter()
+                .map(|d| (d.a.abs() + d.b.abs()) as f64)
+                .sum::<f64>()
+                / hm.directions.len() as f64;
+            println!(
+                "| {n}² | {k} | {:.2} s | {:.0} ms | {period:.1} | {total} | {:.3} % | {worst:.2e}° |",
+                secs,
+                secs * 1e3 / k as f64,
+                100.0 * ok as f64 / total as f64
+            );
+            if n == *sizes.last().unwrap() && k == *counts.last().unwrap() {
+                kept = Some((map.clone(), hm));
+            }
+        }
+    }
+    let (map, hm) = kept.unwrap();
+    println!(
+        "\n### Shadows from the horizon map ({}², {} directions) vs the exact mask\n",
+        map.width,
+        hm.directions.len()
+    );
+    println!("| sun | O(1) mask | exact mask (sweep) | differing pixels |");
+    println!("|---|---|---|---|");
+    for (az, el) in [
+        (300.0, 5.0),
+        (300.0, 10.0),
+        (123.4, 5.0),
+        (123.4, 30.0),
+        (47.0, 2.0),
+    ] {
+        let sun = Sun::new(az, el).unwrap();
+        let t = Instant::now();
+        let fast = hm.shadow_mask(&sun);
+        let tf = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let exact = shadow_mask(
+            &map,
+            &sun,
+            HardMethod::Sweep,
+            None,
+            &relume::progress::Silent,
+        );
+        let te = t.elapsed().as_secs_f64();
+        let differ = exact.iter().zip(&fast).filter(|(a, b)| a != b).count();
+        println!(
+            "| {az}°/{el}° | {:.1} ms | {:.0} ms | {differ} ({:.3} %) |",
+            tf * 1e3,
+            te * 1e3,
+            100.0 * differ as f64 / exact.len() as f64
+        );
+    }
+}

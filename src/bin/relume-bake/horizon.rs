@@ -1,0 +1,245 @@
+//! `horizon` (horizon maps and the sky-view factor) and `sunlight` (hours of direct sun over a
+//! day). Thin: load, call the library, write images atomically.
+
+use crate::terrain::{load_map, MapArgs};
+use crate::ui::Ui;
+use clap::Args;
+use relume::baked::images::{self, check_extension};
+use relume::error::{exit, Error};
+use relume::heightmap::georef::write_geotiff_f32;
+use relume::heightmap::{HeightMap, HeightMapInfo};
+use relume::progress::Progress;
+use relume::terrain::horizon::{decode, HorizonMap};
+use relume::terrain::solar::{Instant, Place};
+use relume::terrain::sunlight::{day_steps, sunlight};
+use relume::Result;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+const NODATA: f64 = -9999.0;
+
+#[derive(Args)]
+pub struct HorizonArgs {
+    #[command(flatten)]
+    pub map: MapArgs,
+    /// Number of azimuths (near-uniform rational directions; their exact azimuths are reported)
+    #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=360))]
+    pub directions: u32,
+    /// Sky-view factor to write (.tif GeoTIFF f32, or .exr)
+    #[arg(long, value_name = "SVF.tif")]
+    pub sky_view: Option<PathBuf>,
+    /// Directory for one horizon-angle GeoTIFF per azimuth (degrees, f32): horizon_AAA.AAA.tif
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct SunlightArgs {
+    #[command(flatten)]
+    pub map: MapArgs,
+    /// The day (a date, 2026-06-21, or any instant of it with a zone); the local mean solar day
+    #[arg(long, value_name = "DATE")]
+    pub date: String,
+    /// Time step: seconds, or with a unit (30s, 10m, 1h)
+    #[arg(long, value_name = "STEP", default_value = "10m")]
+    pub step: String,
+    /// Latitude in degrees (default: the GeoTIFF's centre)
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub lat: Option<f64>,
+    /// Longitude in degrees (default: the GeoTIFF's centre)
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub lon: Option<f64>,
+    /// Horizon azimuths used for the shadows
+    #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=360))]
+    pub directions: u32,
+    /// Hours of direct sun to write (.tif GeoTIFF f32, or .exr)
+    #[arg(long, value_name = "HOURS.tif")]
+    pub out: PathBuf,
+    /// Also the clear-sky direct-beam energy on the sloped surface, Wh/m² (.tif or .exr)
+    #[arg(long, value_name = "WH.tif")]
+    pub insolation: Option<PathBuf>,
+}
+
+/// Write a float raster as GeoTIFF (keeping the input's georeference, no-data −9999) or EXR.
+fn write_raster(path: &Path, map: &HeightMap, info: &HeightMapInfo, v: &[f32]) -> Result<()> {
+    if images::is_exr(path) {
+        return images::write_exr_gray(path, map.width, map.height, v);
+    }
+    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
+    let v: Vec<f32> = (0..v.len())
+        .map(|i| if nodata(i) { NODATA as f32 } else { v[i] })
+        .collect();
+    write_geotiff_f32(
+        path,
+        map.width,
+        map.height,
+        &v,
+        info.georef.as_ref(),
+        Some(NODATA),
+    )
+}
+
+/// `relume-bake horizon`.
+pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
+    if let Some(p) = &args.sky_view {
+        check_extension(p, &["tif", "tiff", "exr"])?;
+    }
+    if args.sky_view.is_none() && args.out.is_none() {
+        return Err(Error::knob(
+            "nothing to write: give --sky-view SVF.tif and/or --out DIR",
+        ));
+    }
+    ui.begin("load", 0);
+    let (map, info) = load_map(&args.map)?;
+    ui.finish();
+    ui.begin("horizon", 0);
+    let t0 = std::time::Instant::now();
+    let hm = HorizonMap::build(&map, args.directions as usize);
+    let seconds = t0.elapsed().as_secs_f64();
+    ui.finish();
+    if let Some(p) = &args.sky_view {
+        write_raster(p, &map, &info, &hm.sky_view())?;
+    }
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create directory", e))?;
+        for (d, plane) in hm.directions.iter().zip(&hm.angles) {
+            let v: Vec<f32> = plane.iter().map(|&q| decode(q) as f32).collect();
+            let p = dir.join(format!("horizon_{:07.3}.tif", d.azimuth_deg));
+            write_raster(&p, &map, &info, &v)?;
+        }
+    }
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({
+                "input": args.map.input.display().to_string(),
+                "width": map.width, "height": map.height,
+                "directions": hm.directions, "seconds": seconds,
+                "sky_view": args.sky_view.as_ref().map(|p| p.display().to_string()),
+                "out": args.out.as_ref().map(|p| p.display().to_string()),
+            }))
+            .expect("json")
+        );
+    } else if !quiet {
+        eprintln!(
+            "{}x{}: {} horizon directions in {seconds:.2} s",
+            map.width,
+            map.height,
+            hm.directions.len()
+        );
+    }
+    Ok(exit::OK)
+}
+
+/// Seconds from `30`, `30s`, `10m`, `1h`.
+fn parse_step(text: &str) -> Result<f64> {
+    let t = text.trim();
+    let (num, unit) = match t.char_indices().find(|(_, c)| c.is_ascii_alphabetic()) {
+        Some((i, _)) => (&t[..i], &t[i..]),
+        None => (t, "s"),
+    };
+    let k = match unit {
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => {
+            return Err(Error::knob(format!(
+                "--step `{text}`: unknown unit `{unit}` (use s, m or h, e.g. 10m)"
+            )))
+        }
+    };
+    match num.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * k),
+        _ => Err(Error::knob(format!(
+            "--step `{text}`: not a positive duration (e.g. 10m)"
+        ))),
+    }
+}
+
+/// `relume-bake sunlight`.
+pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
+    check_extension(&args.out, &["tif", "tiff", "exr"])?;
+    if let Some(p) = &args.insolation {
+        check_extension(p, &["tif", "tiff", "exr"])?;
+    }
+    let step = parse_step(&args.step)?;
+    let date = if args.date.len() == 10 {
+        Instant::parse(&format!("{}T00:00:00Z", args.date))?
+    } else {
+        Instant::parse(&args.date)?
+    };
+    if args.lat.is_some() != args.lon.is_some() {
+        return Err(Error::knob(
+            "give both --lat and --lon, or neither (the GeoTIFF's centre)",
+        ));
+    }
+    ui.begin("load", 0);
+    let (map, info) = load_map(&args.map)?;
+    ui.finish();
+    let (cx, cy) = (map.width as f64 / 2.0, map.height as f64 / 2.0);
+    let geo = info.georef.as_ref();
+    let [lat, lon] = match (args.lat, args.lon) {
+        (Some(a), Some(b)) => [a, b],
+        _ => geo.and_then(|g| g.lat_lon(cx, cy)).ok_or_else(|| {
+            Error::knob("sunlight needs a place: give --lat and --lon (this height map has no geographic or UTM georeference)")
+        })?,
+    };
+    let centre = map.heights[(map.height / 2) * map.width + map.width / 2] as f64;
+    let place = Place::new(lat, lon, centre)?;
+    let up = geo
+        .and_then(|g| g.grid_north_bearing(cx, cy))
+        .unwrap_or(0.0);
+    let steps = day_steps(&date, &place, step, up)?;
+    let t0 = std::time::Instant::now();
+    ui.begin("horizon", 0);
+    let hm = HorizonMap::build(&map, args.directions as usize);
+    ui.finish();
+    let horizon_s = t0.elapsed().as_secs_f64();
+    let t1 = std::time::Instant::now();
+    ui.begin("sunlight", 0);
+    let (hours, energy) = sunlight(&map, &hm, &steps, args.insolation.is_some());
+    ui.finish();
+    let day_s = t1.elapsed().as_secs_f64();
+    write_raster(&args.out, &map, &info, &hours)?;
+    if let (Some(p), Some(e)) = (&args.insolation, &energy) {
+        write_raster(p, &map, &info, e)?;
+    }
+    let daylight: f64 = steps
+        .iter()
+        .filter(|s| s.sun.elevation_deg > 0.0)
+        .map(|s| s.hours)
+        .sum();
+    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
+    let valid: Vec<f64> = (0..hours.len())
+        .filter(|&i| !nodata(i))
+        .map(|i| hours[i] as f64)
+        .collect();
+    let mean = valid.iter().sum::<f64>() / valid.len().max(1) as f64;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({
+                "input": args.map.input.display().to_string(),
+                "width": map.width, "height": map.height,
+                "latitude": lat, "longitude": lon, "grid_north_bearing": up,
+                "steps": steps.len(), "step_seconds": 86_400.0 / steps.len() as f64,
+                "day_start_utc": steps.first().map(|s| s.at.to_string()),
+                "daylight_hours": daylight, "mean_sun_hours": mean,
+                "horizon_seconds": horizon_s, "sunlight_seconds": day_s,
+                "directions": hm.directions.len(),
+                "out": args.out.display().to_string(),
+                "insolation": args.insolation.as_ref().map(|p| p.display().to_string()),
+            }))
+            .expect("json")
+        );
+    } else if !quiet {
+        eprintln!(
+            "{}x{}: {:.2} h of daylight, {mean:.2} h of direct sun on average; horizons {horizon_s:.2} s, day {day_s:.2} s → {}",
+            map.width,
+            map.height,
+            daylight,
+            args.out.display()
+        );
+    }
+    Ok(exit::OK)
+}
