@@ -83,7 +83,7 @@ pub fn directions(n: usize, cell_size: [f64; 2]) -> Vec<Direction> {
     (0..n)
         .map(|k| {
             let target = k as f64 * spacing;
-            let mut best: Option<(i64, f64, Direction)> = None;
+            let mut best: Option<((bool, i64, f64), Direction)> = None;
             for a in -64i64..=64 {
                 for b in -64i64..=64 {
                     if (a, b) == (0, 0) || gcd(a.abs(), b.abs()) != 1 {
@@ -98,22 +98,19 @@ pub fn directions(n: usize, cell_size: [f64; 2]) -> Vec<Direction> {
                     let d = Direction::new(a, b, cell_size);
                     let err = angle_between(d.azimuth_deg, target);
                     let cost = a.abs() + b.abs();
+                    // Within the tolerance: the cheapest, then the closest; else the closest.
+                    let ok = err <= 0.2 * spacing;
+                    let key = (!ok, if ok { cost } else { 0 }, err);
                     let better = match &best {
                         None => true,
-                        Some((c, e, _)) => {
-                            let ok = err <= 0.2 * spacing;
-                            let was_ok = *e <= 0.2 * spacing;
-                            (ok && !was_ok)
-                                || (ok == was_ok && (cost, err) < (*c, *e) && ok)
-                                || (!ok && !was_ok && err < *e)
-                        }
+                        Some((k, _)) => key.partial_cmp(k) == Some(std::cmp::Ordering::Less),
                     };
                     if better {
-                        best = Some((cost, err, d));
+                        best = Some((key, d));
                     }
                 }
             }
-            best.expect("some direction").2
+            best.expect("some direction").1
         })
         .collect()
 }

@@ -37,7 +37,7 @@ pub fn day_steps(
     step_s: f64,
     grid_north_bearing: f64,
 ) -> Result<Vec<Step>> {
-    if !(step_s.is_finite() && step_s >= 1.0 && step_s <= 86_400.0) {
+    if !(1.0..=86_400.0).contains(&step_s) {
         return Err(Error::knob(format!(
             "the time step must be between 1 s and 24 h, got {step_s} s"
         )));
