@@ -219,6 +219,7 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
         })
         .collect();
     let inside = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h;
+    let stencils = Stencils::new(&track, dir, &per);
     starts.par_chunks(256).for_each(|chunk| {
         let mut hull: Vec<(f64, f64)> = Vec::new();
         let mut line: Vec<(i64, i64)> = Vec::new();
@@ -234,22 +235,38 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
             hull.clear();
             for (n, &(c, r)) in line.iter().enumerate().rev() {
                 let tau = n as f64 * period_t;
-                let p = [c as f64 + 0.5, r as f64 + 0.5];
                 let zp = map.heights[(r * w + c) as usize] as f64;
-                // The period's samples beyond the own texel (global τ, height).
                 samples.clear();
-                for t in &per[1..k] {
-                    let (x, y) = (c + t.dx, r + t.dy);
-                    if !inside(x, y) {
-                        break;
+                let (own, full) = if stencils.fits(c, r, w, h) {
+                    // Interior: the period's bilinear stencils, the same for every pixel.
+                    let base = (r * w + c) as isize;
+                    for st in &stencils.period {
+                        samples.push((tau + st.t, st.eval(&map.heights, base, w as isize)));
                     }
-                    let (tm, hq) = texel_sample(map, &track, p, [x, y], t.t_in, t.t_out);
-                    samples.push((tau + tm, hq));
-                }
-                // Own texel, half transit.
-                let t0 = per[0];
-                let (tm0, h0) = texel_sample(map, &track, p, [c, r], 0.0, t0.t_out);
-                let mut best = (h0 - zp) / tm0;
+                    let own = (
+                        stencils.own.t,
+                        stencils.own.eval(&map.heights, base, w as isize),
+                    );
+                    let full = stencils.full.eval(&map.heights, base, w as isize);
+                    (own, (tau + stencils.full.t, full))
+                } else {
+                    let p = [c as f64 + 0.5, r as f64 + 0.5];
+                    for t in &per[1..k] {
+                        let (x, y) = (c + t.dx, r + t.dy);
+                        if !inside(x, y) {
+                            break;
+                        }
+                        let (tm, hq) = texel_sample(map, &track, p, [x, y], t.t_in, t.t_out);
+                        samples.push((tau + tm, hq));
+                    }
+                    let own = texel_sample(map, &track, p, [c, r], 0.0, per[0].t_out);
+                    let f = per[k];
+                    let prev = [p[0] - dir.a as f64, p[1] - dir.b as f64];
+                    let (tm, hq) = texel_sample(map, &track, prev, [c, r], f.t_in, f.t_out);
+                    (own, (tau - period_t + tm, hq))
+                };
+                // The own texel's half transit, the rest of the period, and the hull beyond.
+                let mut best = (own.1 - zp) / own.0;
                 for &(ts, hs) in &samples {
                     best = best.max((hs - zp) / (ts - tau));
                 }
@@ -263,16 +280,106 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
                 for &s in samples.iter().rev() {
                     push(&mut hull, s);
                 }
-                let full = per[k];
-                let prev = [p[0] - dir.a as f64, p[1] - dir.b as f64];
-                let (tm, hq) = texel_sample(map, &track, prev, [c, r], full.t_in, full.t_out);
-                push(&mut hull, (tau - period_t + tm, hq));
+                push(&mut hull, full);
             }
         }
     });
     out.into_iter()
         .map(|v| f32::from_bits(v.into_inner()))
         .collect()
+}
+
+/// A bilinear sample at a fixed offset from a pixel: what [`texel_sample`] computes for every
+/// pixel away from the border (the transit times and the sample's fraction within its cell
+/// are translation invariant: event times are (boundary − p)·(1/u) with boundary − p exact).
+#[derive(Clone, Copy, Debug)]
+struct Stencil {
+    /// The cell's top-left texel relative to the pixel.
+    dx: i64,
+    dy: i64,
+    tx: f64,
+    ty: f64,
+    /// The sample's t from the pixel's centre.
+    t: f64,
+}
+
+impl Stencil {
+    /// From the sample of texel `texel` (relative) on the track from `p` (relative to the
+    /// pixel's corner) between t_in and t_out, as [`texel_sample`] places it.
+    fn new(track: &Track, p: [f64; 2], texel: [i64; 2], t_in: f64, t_out: f64, shift: f64) -> Self {
+        let t_mid = 0.5 * (t_in + t_out);
+        let qx = (p[0] + track.ux * t_mid).clamp(texel[0] as f64, (texel[0] + 1) as f64);
+        let qy = (p[1] + track.uy * t_mid).clamp(texel[1] as f64, (texel[1] + 1) as f64);
+        let (fx, fy) = (qx - 0.5, qy - 0.5);
+        let (x0, y0) = (fx.floor(), fy.floor());
+        Stencil {
+            dx: x0 as i64,
+            dy: y0 as i64,
+            tx: fx - x0,
+            ty: fy - y0,
+            t: t_mid - shift,
+        }
+    }
+
+    #[inline]
+    fn eval(&self, hs: &[f32], base: isize, w: isize) -> f64 {
+        let i = (base + self.dy as isize * w + self.dx as isize) as usize;
+        let (a, b) = (hs[i] as f64, hs[i + 1] as f64);
+        let (c, d) = (hs[i + w as usize] as f64, hs[i + w as usize + 1] as f64);
+        let top = a + (b - a) * self.tx;
+        let bottom = c + (d - c) * self.tx;
+        let v = top + (bottom - top) * self.ty;
+        v.clamp(a.min(b).min(c.min(d)), a.max(b).max(c.max(d)))
+    }
+}
+
+/// The stencils of a direction's period: the own texel's half transit, the rest of the
+/// period, and the own texel's full transit seen from the previous pixel (t relative to this
+/// pixel's centre); with the box of texels they read.
+struct Stencils {
+    own: Stencil,
+    period: Vec<Stencil>,
+    full: Stencil,
+    /// Reads texels (x + lo[0] ..= x + hi[0], y + lo[1] ..= y + hi[1]).
+    lo: [i64; 2],
+    hi: [i64; 2],
+}
+
+impl Stencils {
+    fn new(track: &Track, dir: &Direction, per: &[PeriodTexel]) -> Stencils {
+        let k = per.len() - 1;
+        let c = [0.5, 0.5];
+        let own = Stencil::new(track, c, [0, 0], 0.0, per[0].t_out, 0.0);
+        let period: Vec<Stencil> = per[1..k]
+            .iter()
+            .map(|t| Stencil::new(track, c, [t.dx, t.dy], t.t_in, t.t_out, 0.0))
+            .collect();
+        let prev = [0.5 - dir.a as f64, 0.5 - dir.b as f64];
+        let l = (dir.a as f64).hypot(dir.b as f64);
+        let f = per[k];
+        let full = Stencil::new(track, prev, [0, 0], f.t_in, f.t_out, l);
+        let all = || period.iter().chain([&own, &full]);
+        let lo = [
+            all().map(|s| s.dx).min().unwrap(),
+            all().map(|s| s.dy).min().unwrap(),
+        ];
+        let hi = [
+            all().map(|s| s.dx).max().unwrap() + 1,
+            all().map(|s| s.dy).max().unwrap() + 1,
+        ];
+        Stencils {
+            own,
+            period,
+            full,
+            lo,
+            hi,
+        }
+    }
+
+    /// Do all stencils of pixel (c, r) lie inside a w×h map (so no border clamping applies)?
+    fn fits(&self, c: i64, r: i64, w: i64, h: i64) -> bool {
+        c + self.lo[0] >= 0 && r + self.lo[1] >= 0 && c + self.hi[0] < w && r + self.hi[1] < h
+    }
 }
 
 /// Push a point left of every hull point onto the upper hull (the last element is leftmost).
