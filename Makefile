@@ -11,7 +11,7 @@ export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
 
-.PHONY: all build demo docs-images test deps deps-apt deps-py fuzz fmt lint bench study ci clean
+.PHONY: all build demo docs-images test deps deps-apt deps-py fuzz fmt lint bench bench-grass study ci clean
 
 all: build
 
@@ -116,6 +116,10 @@ docs-images: build
 test: deps
 	@mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
 	$(CARGO) test --release --locked
+
+## GRASS r.sunmask side by side (optional: skips without grass-core; about 4 minutes)
+bench-grass:
+	scripts/grass/sunmask_compare.sh
 
 deps: deps-apt deps-py
 

@@ -12,22 +12,15 @@ use relume::terrain::horizon::{decode, horizon_exact, HorizonMap};
 use relume::terrain::relief::{shadow_mask, HardMethod};
 use relume::terrain::Sun;
 use std::time::Instant;
-use util::{env, load};
+use util::{env_list, load};
 
 #[allow(unused_imports)]
 mod util;
 
-fn list(name: &str, default: &str) -> Vec<usize> {
-    env::<String>(name, default.into())
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect()
-}
-
 fn main() {
     let full = load("puget-sound.ron");
-    let sizes = list("RELUME_BENCH_SIZES", "1024,2048,4096");
-    let counts = list("RELUME_BENCH_DIRECTIONS", "16,32,64");
+    let sizes = env_list::<usize>("RELUME_BENCH_SIZES", "1024,2048,4096");
+    let counts = env_list::<usize>("RELUME_BENCH_DIRECTIONS", "16,32,64");
     println!("## Horizon maps, Puget Sound\n");
     println!(
         "{} threads, wall time of one build (shared machine).\n",

@@ -13,7 +13,7 @@ use relume::terrain::relief::{shadow_mask, HardMethod};
 use relume::terrain::sweep::shadow_mask_sweep;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 use std::time::Instant;
-use util::{env, load};
+use util::{env, env_list, load};
 
 #[allow(unused_imports)]
 mod util;
@@ -31,18 +31,11 @@ fn best<T>(reps: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     (t_best, out.unwrap())
 }
 
-fn list(name: &str, default: &str) -> Vec<f64> {
-    env::<String>(name, default.into())
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect()
-}
-
 fn main() {
     let full = load("puget-sound.ron");
     let az: f64 = env("RELUME_BENCH_AZIMUTH", 300.0);
-    let sizes = list("RELUME_BENCH_SIZES", "1024,2048,4096");
-    let elevations = list("RELUME_BENCH_ELEVATIONS", "2,5,10,30,60");
+    let sizes = env_list::<f64>("RELUME_BENCH_SIZES", "1024,2048,4096");
+    let elevations = env_list::<f64>("RELUME_BENCH_ELEVATIONS", "2,5,10,30,60");
     println!("## Hard shadows: certified sweep vs the read floor, Puget Sound, azimuth {az}°\n");
     println!(
         "{} threads; wall times, best of 3 (floor: best of 5); shared machine: read the ratios.\n",

@@ -127,6 +127,98 @@ pub fn shadowed_exact(
     false
 }
 
+/// One texel of a track with its transit times.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transit {
+    pub ix: i64,
+    pub iy: i64,
+    pub t_in: f64,
+    pub t_out: f64,
+}
+
+/// The texels the exact traversal visits from (col, row), in order, with their transits:
+/// [`shadowed_exact`]'s stepping (the same expressions, the same W + H bound), as an iterator
+/// that allocates nothing — for the kernels that keep more than a yes/no along the track
+/// (horizons, the soft-shadow reference, the sweep's near walks).
+#[derive(Clone, Debug)]
+pub struct TrackWalk<'a> {
+    track: &'a Track,
+    p: [f64; 2],
+    size: [i64; 2],
+    ix: i64,
+    iy: i64,
+    t_in: f64,
+    tx: f64,
+    ty: f64,
+    left: i64,
+}
+
+impl<'a> TrackWalk<'a> {
+    pub fn new(map: &HeightMap, track: &'a Track, col: usize, row: usize) -> TrackWalk<'a> {
+        let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
+        let (ix, iy) = (col as i64, row as i64);
+        let size = [map.width as i64, map.height as i64];
+        TrackWalk {
+            track,
+            p: [px, py],
+            size,
+            ix,
+            iy,
+            t_in: 0.0,
+            tx: Track::exit_time(px, ix, track.step_x, track.inv_ux),
+            ty: Track::exit_time(py, iy, track.step_y, track.inv_uy),
+            left: if track.kind == TrackKind::Ray {
+                size[0] + size[1]
+            } else {
+                0
+            },
+        }
+    }
+
+    /// The pixel centre the track starts from.
+    pub fn start(&self) -> [f64; 2] {
+        self.p
+    }
+
+    /// The texel the walk stands at (the next one it yields).
+    pub fn current(&self) -> (i64, i64) {
+        (self.ix, self.iy)
+    }
+}
+
+impl Iterator for TrackWalk<'_> {
+    type Item = Transit;
+
+    #[inline]
+    fn next(&mut self) -> Option<Transit> {
+        let inside =
+            self.ix >= 0 && self.iy >= 0 && self.ix < self.size[0] && self.iy < self.size[1];
+        if self.left <= 0 || !inside {
+            return None;
+        }
+        self.left -= 1;
+        let t = self.track;
+        let t_out = self.tx.min(self.ty);
+        let out = Transit {
+            ix: self.ix,
+            iy: self.iy,
+            t_in: self.t_in,
+            t_out,
+        };
+        let (step_x, step_y) = (self.tx <= self.ty, self.ty <= self.tx);
+        if step_x {
+            self.ix += t.step_x;
+            self.tx = Track::exit_time(self.p[0], self.ix, t.step_x, t.inv_ux);
+        }
+        if step_y {
+            self.iy += t.step_y;
+            self.ty = Track::exit_time(self.p[1], self.iy, t.step_y, t.inv_uy);
+        }
+        self.t_in = t_out;
+        Some(out)
+    }
+}
+
 /// The texels the exact traversal visits from (col, row), in order, with their transit
 /// times (t_in, t_out) — for tests and diagnostics (allocates; not a kernel).
 pub fn track_texels(
@@ -135,31 +227,9 @@ pub fn track_texels(
     col: usize,
     row: usize,
 ) -> Vec<(i64, i64, f64, f64)> {
-    let mut out = Vec::new();
-    if track.kind != TrackKind::Ray {
-        return out;
-    }
-    let (w, h) = (map.width as i64, map.height as i64);
-    let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
-    let (mut ix, mut iy) = (col as i64, row as i64);
-    let mut t_in = 0.0f64;
-    for _ in 0..(w + h) {
-        let tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
-        let ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
-        let t_out = tx.min(ty);
-        out.push((ix, iy, t_in, t_out));
-        if tx <= ty {
-            ix += track.step_x;
-        }
-        if ty <= tx {
-            iy += track.step_y;
-        }
-        t_in = t_out;
-        if ix < 0 || iy < 0 || ix >= w || iy >= h {
-            break;
-        }
-    }
-    out
+    TrackWalk::new(map, track, col, row)
+        .map(|t| (t.ix, t.iy, t.t_in, t.t_out))
+        .collect()
 }
 
 #[cfg(test)]

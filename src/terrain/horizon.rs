@@ -25,7 +25,7 @@
 //! of the translated times (a few ulps), so the sweep agrees with [`horizon_exact`] to
 //! ~1e-9°.
 
-use super::exact_traversal::texel_sample;
+use super::exact_traversal::{texel_sample, TrackWalk};
 use super::sun::{Track, TrackKind};
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
@@ -133,31 +133,16 @@ pub fn angle_between(a: f64, b: f64) -> f64 {
 /// [`super::exact_traversal::shadowed_exact`], keeping the steepest sample, stopping once the
 /// map's maximum cannot be steeper. −90° is never returned: P's own texel always has a sample.
 pub fn horizon_exact(map: &HeightMap, track: &Track, col: usize, row: usize, max: f32) -> f64 {
-    let (w, h) = (map.width as i64, map.height as i64);
-    let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
     let zp = map.heights[row * map.width + col] as f64;
-    let (mut ix, mut iy) = (col as i64, row as i64);
-    let mut t_in = 0.0f64;
-    let mut tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
-    let mut ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
+    let walk = TrackWalk::new(map, track, col, row);
+    let p = walk.start();
     let mut best = f64::NEG_INFINITY;
-    for _ in 0..(w + h) {
-        let t_out = tx.min(ty);
-        let (t_mid, hq) = texel_sample(map, track, [px, py], [ix, iy], t_in, t_out);
-        best = best.max((hq - zp) / t_mid);
-        let (step_x, step_y) = (tx <= ty, ty <= tx);
-        if step_x {
-            ix += track.step_x;
-            tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
-        }
-        if step_y {
-            iy += track.step_y;
-            ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
-        }
-        t_in = t_out;
-        if ix < 0 || iy < 0 || ix >= w || iy >= h || (max as f64 - zp) <= best * t_in {
+    for t in walk {
+        if (max as f64 - zp) <= best * t.t_in {
             break;
         }
+        let (t_mid, hq) = texel_sample(map, track, p, [t.ix, t.iy], t.t_in, t.t_out);
+        best = best.max((hq - zp) / t_mid);
     }
     (best / track.metres_per_t).atan().to_degrees()
 }

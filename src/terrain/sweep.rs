@@ -36,7 +36,7 @@
 //! The answer of every pixel is exact, so it does not depend on the order or the threads.
 
 use super::accelerated_traversal::shadowed_accelerated;
-use super::exact_traversal::{shadowed_exact, texel_sample};
+use super::exact_traversal::{shadowed_exact, texel_sample, TrackWalk};
 use super::minmax_mipmap::MinMaxMipmap;
 use super::sun::{Track, TrackKind};
 use super::sweep_bound::{directional_bound, transpose};
@@ -319,73 +319,41 @@ impl<'a> Frame<'a> {
     }
 }
 
-/// The exact traversal's walk ([`shadowed_exact`], the same expressions), run one major-axis
-/// line at a time.
+/// The exact traversal's walk ([`TrackWalk`]: [`shadowed_exact`]'s stepping), run one
+/// major-axis line at a time.
 struct Walk<'a> {
     map: &'a HeightMap,
     track: &'a Track,
-    p: [f64; 2],
+    walk: TrackWalk<'a>,
     zp: f64,
-    ix: i64,
-    iy: i64,
-    t_in: f64,
-    tx: f64,
-    ty: f64,
     transposed: bool,
-    done: bool,
 }
 
 impl<'a> Walk<'a> {
     fn new(map: &'a HeightMap, track: &'a Track, col: usize, row: usize, transposed: bool) -> Self {
-        let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
-        let (ix, iy) = (col as i64, row as i64);
         Walk {
             map,
             track,
-            p: [px, py],
+            walk: TrackWalk::new(map, track, col, row),
             zp: map.heights[row * map.width + col] as f64,
-            ix,
-            iy,
-            t_in: 0.0,
-            tx: Track::exit_time(px, ix, track.step_x, track.inv_ux),
-            ty: Track::exit_time(py, iy, track.step_y, track.inv_uy),
             transposed,
-            done: false,
         }
     }
 
     /// Test the texels of the current major-axis line; `true` when one is above the ray.
-    /// Afterwards the walk stands at the first texel of the next line (or is done: off the map).
+    /// Afterwards the walk stands at the first texel of the next line (or has left the map).
     fn through_line(&mut self) -> bool {
-        let (w, h) = (self.map.width as i64, self.map.height as i64);
-        let major = |s: &Self| if s.transposed { s.ix } else { s.iy };
-        let line = major(self);
-        while !self.done && major(self) == line {
-            let t_out = self.tx.min(self.ty);
-            let (t_mid, hq) = texel_sample(
-                self.map,
-                self.track,
-                self.p,
-                [self.ix, self.iy],
-                self.t_in,
-                t_out,
-            );
+        let major = |(x, y): (i64, i64)| if self.transposed { x } else { y };
+        let line = major(self.walk.current());
+        let p = self.walk.start();
+        while major(self.walk.current()) == line {
+            let Some(t) = self.walk.next() else {
+                break;
+            };
+            let (t_mid, hq) = texel_sample(self.map, self.track, p, [t.ix, t.iy], t.t_in, t.t_out);
             if hq - self.zp > self.track.rise_per_t * t_mid {
                 return true;
             }
-            let (step_x, step_y) = (self.tx <= self.ty, self.ty <= self.tx);
-            if step_x {
-                self.ix += self.track.step_x;
-                self.tx =
-                    Track::exit_time(self.p[0], self.ix, self.track.step_x, self.track.inv_ux);
-            }
-            if step_y {
-                self.iy += self.track.step_y;
-                self.ty =
-                    Track::exit_time(self.p[1], self.iy, self.track.step_y, self.track.inv_uy);
-            }
-            self.t_in = t_out;
-            self.done = self.ix < 0 || self.iy < 0 || self.ix >= w || self.iy >= h;
         }
         false
     }

@@ -1,7 +1,7 @@
 //! `horizon` (horizon maps and the sky-view factor) and `sunlight` (hours of direct sun over a
 //! day). Thin: load, call the library, write images atomically.
 
-use crate::terrain::{load_map, MapArgs};
+use crate::terrain::{load_map, print_json, MapArgs};
 use crate::ui::Ui;
 use clap::Args;
 use relume::baked::images::{self, check_extension};
@@ -109,17 +109,13 @@ pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i
         }
     }
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({
+        print_json(&json!({
                 "input": args.map.input.display().to_string(),
                 "width": map.width, "height": map.height,
                 "directions": hm.directions, "seconds": seconds,
                 "sky_view": args.sky_view.as_ref().map(|p| p.display().to_string()),
                 "out": args.out.as_ref().map(|p| p.display().to_string()),
-            }))
-            .expect("json")
-        );
+        }));
     } else if !quiet {
         eprintln!(
             "{}x{}: {} horizon directions in {seconds:.2} s",
@@ -216,9 +212,7 @@ pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Re
         .collect();
     let mean = valid.iter().sum::<f64>() / valid.len().max(1) as f64;
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({
+        print_json(&json!({
                 "input": args.map.input.display().to_string(),
                 "width": map.width, "height": map.height,
                 "latitude": lat, "longitude": lon, "grid_north_bearing": up,
@@ -229,9 +223,7 @@ pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Re
                 "directions": hm.directions.len(),
                 "out": args.out.display().to_string(),
                 "insolation": args.insolation.as_ref().map(|p| p.display().to_string()),
-            }))
-            .expect("json")
-        );
+        }));
     } else if !quiet {
         eprintln!(
             "{}x{}: {:.2} h of daylight, {mean:.2} h of direct sun on average; horizons {horizon_s:.2} s, day {day_s:.2} s → {}",
