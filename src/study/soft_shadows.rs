@@ -31,7 +31,7 @@ impl SoftConfig {
         SoftConfig {
             elevations: vec![2.0, 5.0, 10.0],
             rows: 128,
-            methods: methods(&[32, 100, 256], &[0, 4, 8]),
+            methods: methods(&[32, 100, 256], &[0, 1, 2, 3, 4, 8]),
         }
     }
 
