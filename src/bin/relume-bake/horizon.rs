@@ -1,6 +1,7 @@
 //! `horizon` (horizon maps and the sky-view factor) and `sunlight` (hours of direct sun over a
 //! day). Thin: load, call the library, write images atomically.
 
+use crate::sun_args::place_of;
 use crate::terrain::{load_map, print_json, MapArgs};
 use crate::ui::Ui;
 use clap::Args;
@@ -10,7 +11,7 @@ use relume::heightmap::georef::write_geotiff_f32;
 use relume::heightmap::{HeightMap, HeightMapInfo};
 use relume::progress::Progress;
 use relume::terrain::horizon::{decode, HorizonMap};
-use relume::terrain::solar::{Instant, Place};
+use relume::terrain::solar::Instant;
 use relume::terrain::sunlight::{day_steps, sunlight};
 use relume::Result;
 use serde_json::json;
@@ -172,19 +173,8 @@ pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Re
     ui.begin("load", 0);
     let (map, info) = load_map(&args.map)?;
     ui.finish();
-    let (cx, cy) = (map.width as f64 / 2.0, map.height as f64 / 2.0);
-    let geo = info.georef.as_ref();
-    let [lat, lon] = match (args.lat, args.lon) {
-        (Some(a), Some(b)) => [a, b],
-        _ => geo.and_then(|g| g.lat_lon(cx, cy)).ok_or_else(|| {
-            Error::knob("sunlight needs a place: give --lat and --lon (this height map has no geographic or UTM georeference)")
-        })?,
-    };
-    let centre = map.heights[(map.height / 2) * map.width + map.width / 2] as f64;
-    let place = Place::new(lat, lon, centre)?;
-    let up = geo
-        .and_then(|g| g.grid_north_bearing(cx, cy))
-        .unwrap_or(0.0);
+    let (place, up) = place_of(&map, &info, args.lat.zip(args.lon), "sunlight")?;
+    let (lat, lon) = (place.latitude_deg, place.longitude_deg);
     let steps = day_steps(&date, &place, step, up)?;
     let t0 = std::time::Instant::now();
     ui.begin("horizon", 0);

@@ -86,27 +86,9 @@ impl SunArgs {
             .as_deref()
             .expect("clap requires --date without the angles");
         let at = Instant::parse(date)?;
-        let (cx, cy) = (map.width as f64 / 2.0, map.height as f64 / 2.0);
-        let geo = info.georef.as_ref();
-        let (lat, lon) = match (self.lat, self.lon) {
-            (Some(la), Some(lo)) => (la, lo),
-            _ => match geo.and_then(|g| g.lat_lon(cx, cy)) {
-                Some([la, lo]) => (la, lo),
-                None => {
-                    return Err(Error::knob(
-                        "--date needs a place: give --lat and --lon (this height map has no \
-                         geographic or UTM georeference)",
-                    ))
-                }
-            },
-        };
-        let centre = map.heights[(map.height / 2) * map.width + map.width / 2] as f64;
-        let place = Place::new(lat, lon, centre)?;
+        let (place, up) = place_of(map, info, self.lat.zip(self.lon), "--date")?;
+        let (lat, lon) = (place.latitude_deg, place.longitude_deg);
         let pos = solar_position(&at, &place, &SpaOptions::default())?;
-        // The grid's up is not true north on a projected map (UTM: the meridian convergence).
-        let up = geo
-            .and_then(|g| g.grid_north_bearing(cx, cy))
-            .unwrap_or(0.0);
         let sun = Sun::new((pos.azimuth_deg - up).rem_euclid(360.0), pos.elevation_deg)?;
         Ok((
             sun,
@@ -117,4 +99,33 @@ impl SunArgs {
             }),
         ))
     }
+}
+
+/// Where a height map lies for the sun: `given` (latitude, longitude), else the centre of its
+/// geographic or UTM georeference, at the centre texel's height; and the true bearing of the
+/// grid's up there (the meridian convergence on UTM; 0 without a georeference). `what` names
+/// the option that needs the place, for the error.
+pub fn place_of(
+    map: &HeightMap,
+    info: &HeightMapInfo,
+    given: Option<(f64, f64)>,
+    what: &str,
+) -> Result<(Place, f64)> {
+    let (cx, cy) = (map.width as f64 / 2.0, map.height as f64 / 2.0);
+    let geo = info.georef.as_ref();
+    let (lat, lon) =
+        match given.or_else(|| geo.and_then(|g| g.lat_lon(cx, cy)).map(|[a, b]| (a, b))) {
+            Some(p) => p,
+            None => {
+                return Err(Error::knob(format!(
+                "{what} needs a place: give --lat and --lon (this height map has no geographic \
+                 or UTM georeference)"
+            )))
+            }
+        };
+    let centre = map.heights[(map.height / 2) * map.width + map.width / 2] as f64;
+    let up = geo
+        .and_then(|g| g.grid_north_bearing(cx, cy))
+        .unwrap_or(0.0);
+    Ok((Place::new(lat, lon, centre)?, up))
 }
