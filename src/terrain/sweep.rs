@@ -115,6 +115,8 @@ struct Frame<'a> {
     m: f64,
     rise: f64,
     eps: f64,
+    /// The map's largest height (the plain traversal's early stop).
+    max_height: f32,
 }
 
 impl<'a> Frame<'a> {
@@ -145,6 +147,7 @@ impl<'a> Frame<'a> {
             m: ucx / ucy,
             rise,
             eps,
+            max_height: hi,
         }
     }
 
@@ -196,7 +199,7 @@ impl<'a> Frame<'a> {
         let mut prev_row = usize::MAX;
         let mut g = vec![0.0f64; self.w];
         let mut stats = SweepStats::default();
-        let (_, max_height) = map.min_max();
+        let max_height = self.max_height;
         let up = self.ucy > 0.0;
         let kx = self.rise * self.ucx;
         for step in 0..self.h {
