@@ -138,7 +138,8 @@ pub struct Transit {
 
 /// The texels the exact traversal visits from (col, row), in order, with their transits:
 /// [`shadowed_exact`]'s stepping (the same expressions, the same W + H bound), as an iterator
-/// that allocates nothing — for the kernels that keep more than a yes/no along the track
+/// that allocates nothing, whatever the sun's elevation (the soft-shadow reference walks below
+/// the horizon too) — for the kernels that keep more than a yes/no along the track
 /// (horizons, the soft-shadow reference, the sweep's near walks).
 #[derive(Clone, Debug)]
 pub struct TrackWalk<'a> {
@@ -227,6 +228,9 @@ pub fn track_texels(
     col: usize,
     row: usize,
 ) -> Vec<(i64, i64, f64, f64)> {
+    if track.kind != TrackKind::Ray {
+        return Vec::new();
+    }
     TrackWalk::new(map, track, col, row)
         .map(|t| (t.ix, t.iy, t.t_in, t.t_out))
         .collect()

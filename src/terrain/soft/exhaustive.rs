@@ -8,7 +8,7 @@
 
 use super::model::{beyond_reach, slope, PixelSun};
 use crate::heightmap::HeightMap;
-use crate::terrain::exact_traversal::{texel_sample, TrackWalk};
+use crate::terrain::exact_traversal::texel_sample;
 use crate::terrain::sun::Track;
 
 /// Lit fraction of the pixel at (col, row). `range` = (max, min) height of the map.
@@ -24,25 +24,40 @@ pub fn lit_exhaustive(
     if let Some(v) = ps.settled() {
         return v;
     }
+    let (w, h) = (map.width as i64, map.height as i64);
+    let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
     let (hmax, hmin) = (range.0 as f64, range.1 as f64);
     let m = track.metres_per_t;
-    let walk = TrackWalk::new(map, track, col, row);
-    let p = walk.start();
+    let (mut ix, mut iy) = (col as i64, row as i64);
+    let mut t_in = 0.0f64;
+    let mut tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
+    let mut ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
     let mut best = ps.best_init;
-    for t in walk {
-        if t.t_in > 0.0
-            && early_stop
-            && beyond_reach(hmax, hmin, ps.zp, m * t.t_in, ps.radius, best)
-        {
-            break;
-        }
-        let (t_mid, hq) = texel_sample(map, track, p, [t.ix, t.iy], t.t_in, t.t_out);
+    for _ in 0..(w + h) {
+        let t_out = tx.min(ty);
+        let (t_mid, hq) = texel_sample(map, track, [px, py], [ix, iy], t_in, t_out);
         let s = slope(hq, ps.zp, m * t_mid, ps.radius);
         if s > best {
             best = s;
             if best >= ps.slope_dark {
                 return 0.0;
             }
+        }
+        let (step_x, step_y) = (tx <= ty, ty <= tx);
+        if step_x {
+            ix += track.step_x;
+            tx = Track::exit_time(px, ix, track.step_x, track.inv_ux);
+        }
+        if step_y {
+            iy += track.step_y;
+            ty = Track::exit_time(py, iy, track.step_y, track.inv_uy);
+        }
+        t_in = t_out;
+        if ix < 0 || iy < 0 || ix >= w || iy >= h {
+            break;
+        }
+        if early_stop && beyond_reach(hmax, hmin, ps.zp, m * t_in, ps.radius, best) {
+            break;
         }
     }
     ps.lit_fraction(best)
