@@ -8,7 +8,8 @@
 //! RELUME_BENCH_DIRECTIONS, default "16,32,64").
 
 use rayon::prelude::*;
-use relume::terrain::horizon::{decode, horizon_exact, HorizonMap};
+use relume::terrain::horizon::horizon_exact;
+use relume::terrain::horizon_map::{decode, HorizonMap, HorizonSettings};
 use relume::terrain::relief::{shadow_mask, HardMethod};
 use relume::terrain::Sun;
 use std::time::Instant;
@@ -34,7 +35,13 @@ fn main() {
         let (_, max) = map.min_max();
         for &k in &counts {
             let t = Instant::now();
-            let hm = HorizonMap::build(&map, k);
+            let hm = HorizonMap::build(
+                &map,
+                &HorizonSettings {
+                    directions: k,
+                    planet_radius: None,
+                },
+            );
             let secs = t.elapsed().as_secs_f64();
             let stride = if n >= 4096 { 16 } else { 8 };
             let pixels: Vec<(usize, usize)> = (0..map.height)

@@ -1,11 +1,11 @@
 // Shadow of every texel of the height map, the GPU half of the shadow twin tests: the hard mask
-// (1 = in shadow) by the exact (A1) or the accelerated (A2) traversal, or the soft lit fraction
+// (1 = in shadow) by the exact (A1) or the accelerated (A2) traversal or the horizon maps, or the soft lit fraction
 // (f32 bits) by branch-and-bound. Rust twins: relume::terrain::relief::shadow_mask and
 // relume::terrain::soft::soft_shadow_map.
 //! include terrain_shadow.wgsl
 
 struct MaskParams {
-    method: u32,          // 0 exact, 1 accelerated, 2 soft (lit fraction)
+    method: u32,          // 0 exact, 1 accelerated, 2 soft (lit fraction), 3 horizon maps
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
@@ -25,7 +25,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var shadowed: bool;
-    if (mask_params.method == 1u) {
+    if (mask_params.method == 3u) {
+        shadowed = shadowed_horizon(i32(id.x), i32(id.y));
+    } else if (mask_params.method == 1u) {
         shadowed = shadowed_accelerated(i32(id.x), i32(id.y));
     } else {
         shadowed = shadowed_exact(i32(id.x), i32(id.y));

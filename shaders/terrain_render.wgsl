@@ -1,6 +1,6 @@
 // Terrain frame: the height field as a grid mesh (x east = column · cell_x, y up = height,
 // z south = row · cell_y), shaded per pixel at the pixel's texel: hypsometric tint × (Lambert ×
-// shadow brightness + sky), relief shadows by the accelerated traversal (hard), aerial
+// shadow brightness + sky), relief shadows by the accelerated traversal or the horizon maps (hard), aerial
 // perspective, tone map; soft shadows (the sun disc's lit fraction by branch-and-bound) on
 // request. Rust twin: relume::render::terrain_shading.
 //! include terrain_shadow.wgsl
@@ -12,7 +12,7 @@ struct TerrainFrame {
     cell: vec4<f32>,           // cell_x, cell_y, vertical exaggeration, grid step (texels)
     fog: vec4<f32>,            // extinction per metre, scattering albedo, anisotropy g, sun strength
     exposure: f32,
-    flags: u32,                // bit 0 shadows, bit 1 fog, bit 2 soft shadows
+    flags: u32,                // bit 0 shadows, bit 1 fog, bit 2 soft shadows, bit 3 horizon maps
     min_height: f32,
     max_height_tint: f32,
 }
@@ -95,6 +95,8 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
     if ((frame.flags & 1u) != 0u) {
         if ((frame.flags & 4u) != 0u) {
             shadow = 1.0 - lit_branch_and_bound(col, row);
+        } else if ((frame.flags & 8u) != 0u) {
+            shadow = select(0.0, 1.0, shadowed_horizon(col, row));
         } else if (shadowed_accelerated(col, row)) {
             shadow = 1.0;
         }

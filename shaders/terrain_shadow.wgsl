@@ -39,15 +39,20 @@ struct TerrainParams {
     cell_x: f32,
     cell_y: f32,
     tan_alpha: f32,
-    _pad2: u32,
-    _pad3: u32,
-    _pad4: u32,
+    // Horizon-map shadows: the weight of the second of the two planes in `horizon_pair`, the
+    // sun's elevation in degrees, and 1 when `horizon_pair` holds them (0: a placeholder).
+    horizon_w: f32,
+    elevation_deg: f32,
+    has_horizon: u32,
 }
 
 @group(1) @binding(0) var<uniform> terrain: TerrainParams;
 @group(1) @binding(1) var<storage, read> heights: array<f32>;
 @group(1) @binding(2) var<storage, read> mip: array<f32>;            // (max, min) per texel, levels concatenated
 @group(1) @binding(3) var<storage, read> mip_levels: array<vec4<u32>>; // (width, height, offset, 0) per level
+// The two horizon-map planes around the sun's azimuth, per texel: the plane before in the low
+// 16 bits, the plane after in the high 16 (relume::terrain::horizon_map).
+@group(1) @binding(4) var<storage, read> horizon_pair: array<u32>;
 
 fn height_at(col: i32, row: i32) -> f32 {
     return heights[u32(row) * terrain.width + u32(col)];
@@ -443,4 +448,26 @@ fn lit_branch_and_bound(col: i32, row: i32) -> f32 {
         }
     }
     return lit_fraction(ps, best);
+}
+
+// Degrees per step of a quantised horizon angle: relume::terrain::horizon_map::STEP_DEG.
+const HORIZON_STEP_DEG: f32 = 180.0 / 65535.0;
+
+// Hard shadow from the horizon maps in O(1): below the horizon interpolated between the two
+// stored azimuths around the sun's. Rust twin: relume::terrain::horizon_map::shadowed_f32 (with
+// HorizonMap::shadow_mask_f32 for the sun at the zenith or below the horizon).
+fn shadowed_horizon(col: i32, row: i32) -> bool {
+    if (terrain.has_horizon == 0u) {
+        return shadowed_accelerated(col, row);
+    }
+    if (terrain.kind == TRACK_ZENITH) {
+        return false;
+    }
+    if (terrain.kind == TRACK_BELOW) {
+        return true;
+    }
+    let v = horizon_pair[u32(row) * terrain.width + u32(col)];
+    let h0 = f32(v & 0xffffu) * HORIZON_STEP_DEG - 90.0;
+    let h1 = f32(v >> 16u) * HORIZON_STEP_DEG - 90.0;
+    return terrain.elevation_deg < h0 + (h1 - h0) * terrain.horizon_w;
 }

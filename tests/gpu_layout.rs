@@ -166,9 +166,9 @@ fn shared_structs() -> Vec<Shared> {
             "cell_x": field!(TerrainParams, cell_x),
             "cell_y": field!(TerrainParams, cell_y),
             "tan_alpha": field!(TerrainParams, tan_alpha),
-            "_pad2": pad!(TerrainParams, pad1, 0),
-            "_pad3": pad!(TerrainParams, pad1, 1),
-            "_pad4": pad!(TerrainParams, pad1, 2),
+            "horizon_w": field!(TerrainParams, horizon_w),
+            "elevation_deg": field!(TerrainParams, elevation_deg),
+            "has_horizon": field!(TerrainParams, has_horizon),
         }),
         // Written as words by RadiosityRuntime, the dense gather, the corner transfer, the
         // terrain mask pass and the tone-map test.

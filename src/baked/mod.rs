@@ -3,7 +3,7 @@
 //! written through a [`BakeTransaction`] so that a bake appears whole or not at all.
 //!
 //! One module per file kind (`scene`, `heightmap`, `patches`, `form_factors`, `transport`,
-//! `permutation`, `encoded`, `mipmap`): its file name, reader and writer; nothing else reads or
+//! `permutation`, `encoded`, `mipmap`, `horizon`): its file name, reader and writer; nothing else reads or
 //! writes that file. File kinds: `scene.bin` and other structured records are postcard-encoded (a stable,
 //! documented serde wire format); matrices are NumPy `.npy` (little-endian f32, C order) so anyone
 //! can check them with numpy; images and height fields are OpenEXR.
@@ -13,6 +13,7 @@ pub mod export;
 pub mod exr_io;
 pub mod form_factors;
 pub mod heightmap;
+pub mod horizon;
 pub mod images;
 pub mod manifest;
 pub mod mipmap;

@@ -1,11 +1,55 @@
-//! NumPy `.npy` files of f32 (little-endian, C order): the matrices of a bake, readable by numpy.
+//! NumPy `.npy` files (little-endian, C order) of f32 (the matrices of a bake), u16 (horizon
+//! maps) and i32 (their directions): readable by numpy.
 
 use crate::error::{Error, IoContext, Result};
 use std::path::Path;
 
+/// An element type relume writes to and reads from `.npy`.
+pub trait NpyElement: Copy + npyz::Serialize + npyz::AutoSerialize {
+    /// numpy's `descr` of the little-endian type, quoted as in the header.
+    const DESCR: &'static str;
+    /// Bytes per element.
+    const SIZE: usize;
+    /// The Rust name, for messages.
+    const NAME: &'static str;
+    /// The element from its little-endian bytes (`SIZE` of them).
+    fn from_le(bytes: &[u8]) -> Self;
+}
+
+impl NpyElement for f32 {
+    const DESCR: &'static str = "'<f4'";
+    const SIZE: usize = 4;
+    const NAME: &'static str = "f32";
+    fn from_le(b: &[u8]) -> Self {
+        f32::from_le_bytes(b.try_into().unwrap())
+    }
+}
+
+impl NpyElement for u16 {
+    const DESCR: &'static str = "'<u2'";
+    const SIZE: usize = 2;
+    const NAME: &'static str = "u16";
+    fn from_le(b: &[u8]) -> Self {
+        u16::from_le_bytes(b.try_into().unwrap())
+    }
+}
+
+impl NpyElement for i32 {
+    const DESCR: &'static str = "'<i4'";
+    const SIZE: usize = 4;
+    const NAME: &'static str = "i32";
+    fn from_le(b: &[u8]) -> Self {
+        i32::from_le_bytes(b.try_into().unwrap())
+    }
+}
+
 /// Write an f32 array as `.npy` with the given shape (C order).
 pub fn write_npy_f32(path: &Path, shape: &[u64], data: &[f32]) -> Result<()> {
-    use npyz::WriterBuilder;
+    write_npy(path, shape, data)
+}
+
+/// Write an array as `.npy` with the given shape (C order).
+pub fn write_npy<T: NpyElement>(path: &Path, shape: &[u64], data: &[T]) -> Result<()> {
     let expected: u64 = shape.iter().product();
     if expected != data.len() as u64 {
         return Err(Error::Internal(format!(
@@ -13,6 +57,16 @@ pub fn write_npy_f32(path: &Path, shape: &[u64], data: &[f32]) -> Result<()> {
             data.len()
         )));
     }
+    write_npy_iter(path, shape, data.iter().copied())
+}
+
+/// Write the values of `data` (exactly the shape's product of them, streamed) as `.npy`.
+pub fn write_npy_iter<T: NpyElement>(
+    path: &Path,
+    shape: &[u64],
+    data: impl Iterator<Item = T>,
+) -> Result<()> {
+    use npyz::WriterBuilder;
     let file = std::fs::File::create(path).at(path, "cannot write")?;
     let mut w = npyz::WriteOptions::new()
         .default_dtype()
@@ -20,7 +74,7 @@ pub fn write_npy_f32(path: &Path, shape: &[u64], data: &[f32]) -> Result<()> {
         .writer(std::io::BufWriter::new(file))
         .begin_nd()
         .at(path, "cannot write")?;
-    w.extend(data.iter().copied()).at(path, "cannot write")?;
+    w.extend(data).at(path, "cannot write")?;
     w.finish().at(path, "cannot write")
 }
 
@@ -33,13 +87,23 @@ pub fn write_npy_f32(path: &Path, shape: &[u64], data: &[f32]) -> Result<()> {
 /// this parser accepts exactly that, in time linear in the header. `npyz` still writes the files,
 /// and numpy reads them in the tests: the two sides stay independent.
 pub fn read_npy_f32(path: &Path) -> Result<(Vec<u64>, Vec<f32>)> {
+    read_npy(path)
+}
+
+/// Read a `.npy` file of `T` (see [`read_npy_f32`]): (shape, values).
+pub fn read_npy<T: NpyElement>(path: &Path) -> Result<(Vec<u64>, Vec<T>)> {
     let bytes = std::fs::read(path).at(path, "cannot read")?;
-    let (shape, data) = parse_npy_f32(&bytes).map_err(|m| Error::input(path, m))?;
+    let (shape, data) = parse_npy(&bytes).map_err(|m| Error::input(path, m))?;
     Ok((shape, data))
 }
 
 /// Parse the bytes of an f32 `.npy` file (see [`read_npy_f32`]); the error is a message.
 pub fn parse_npy_f32(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<f32>), String> {
+    parse_npy(bytes)
+}
+
+/// Parse the bytes of a `.npy` file of `T` (see [`read_npy_f32`]); the error is a message.
+pub fn parse_npy<T: NpyElement>(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<T>), String> {
     let bad = |m: &str| format!("not a .npy file: {m}");
     if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
         return Err(bad("missing the \\x93NUMPY magic"));
@@ -82,8 +146,8 @@ pub fn parse_npy_f32(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<f32>), 
         rest = next.strip_prefix(',').unwrap_or(next);
     }
     match descr {
-        Some("'<f4'") => {}
-        Some(d) => return Err(format!("not an f32 .npy file: dtype {d}")),
+        Some(d) if d == T::DESCR => {}
+        Some(d) => return Err(format!("not a .npy file of {}: dtype {d}", T::NAME)),
         None => return Err(bad("no 'descr' in the header")),
     }
     if fortran != Some("False") {
@@ -101,17 +165,17 @@ pub fn parse_npy_f32(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<f32>), 
         .map_err(|_| bad(&format!("shape ({dims}) is not a tuple of sizes")))?;
     let data = &bytes[start + len..];
     let count = shape.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
-    if count.and_then(|c| c.checked_mul(4)) != Some(data.len() as u64) {
+    let size = T::SIZE as u64;
+    if count.and_then(|c| c.checked_mul(size)) != Some(data.len() as u64) {
         return Err(bad(&format!(
             "shape {shape:?} needs {} bytes of data, the file has {}",
-            count.map_or("more than 2^64".into(), |c| (c * 4).to_string()),
+            count
+                .and_then(|c| c.checked_mul(size))
+                .map_or("more than 2^64".into(), |c| c.to_string()),
             data.len()
         )));
     }
-    let values = data
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
-        .collect();
+    let values = data.chunks_exact(T::SIZE).map(T::from_le).collect();
     Ok((shape, values))
 }
 
@@ -150,9 +214,25 @@ mod tests {
     }
 
     #[test]
+    fn u16_and_i32_round_trip_and_keep_their_types() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.npy");
+        let v: Vec<u16> = vec![0, 1, 65535, 32768, 7, 9];
+        write_npy(&p, &[3, 2], &v).unwrap();
+        assert_eq!(read_npy::<u16>(&p).unwrap(), (vec![3, 2], v));
+        assert!(read_npy::<f32>(&p).unwrap_err().to_string().contains("<u2"));
+        let d: Vec<i32> = vec![-3, 1, 64, -64];
+        write_npy(&p, &[2, 2], &d).unwrap();
+        assert_eq!(read_npy::<i32>(&p).unwrap(), (vec![2, 2], d));
+        assert!(read_npy::<u16>(&p).unwrap_err().to_string().contains("<i4"));
+    }
+
+    #[test]
     fn refuses_what_it_does_not_write() {
         let err = |b: &[u8]| parse_npy_f32(b).unwrap_err();
-        assert!(err(&numpy_file("(2,)", "<f8", &[0., 0., 0., 0.])).contains("not an f32"));
+        assert!(
+            err(&numpy_file("(2,)", "<f8", &[0., 0., 0., 0.])).contains("not a .npy file of f32")
+        );
         let good = numpy_file("(2, 3)", "<f4", &[0.; 6]);
         assert!(err(&good[..good.len() - 4]).contains("needs 24 bytes"));
         assert!(err(&good[..40]).contains("runs past the end"));

@@ -15,8 +15,8 @@ use std::path::PathBuf;
 
 const KEYS: &str = "\
 Window keys: mouse drag or arrows orbit, wheel or +/- zoom, J/L sun azimuth, I/K sun elevation,
-S sun on/off, 1 direct, 2 indirect, 3 shadows, 4 emission, 5 soft shadows, 6 fog, [ ] exposure,
-Esc quit.";
+S sun on/off, 1 direct, 2 indirect, 3 shadows, 4 emission, 5 soft shadows, 6 fog, 7 terrain
+hard shadows from horizon maps / by traversal, [ ] exposure, Esc quit.";
 
 fn after_help() -> String {
     format!("{}\n\n{KEYS}", exit::HELP)
@@ -77,6 +77,10 @@ struct Cli {
     /// Terrain: soft shadows of the sun's disc (branch-and-bound) instead of hard ones
     #[arg(long)]
     soft: bool,
+    /// Terrain: hard shadows by the traversal over the min/max mipmap even when the bake has
+    /// horizon maps (which give them in O(1) per pixel, interpolated between stored azimuths)
+    #[arg(long)]
+    no_horizon: bool,
     /// Terrain: no aerial perspective
     #[arg(long)]
     no_fog: bool,
@@ -118,6 +122,7 @@ fn settings(cli: &Cli) -> FrameSettings {
         indirect: !cli.no_indirect,
         shadows: !cli.no_shadows,
         soft_shadows: cli.soft,
+        horizon_shadows: !cli.no_horizon,
         fog: !cli.no_fog,
         ..Default::default()
     }

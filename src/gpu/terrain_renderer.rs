@@ -8,6 +8,7 @@ use super::{compute, timing::PassTimer, Gpu};
 use crate::error::{Error, Result};
 use crate::heightmap::HeightMap;
 use crate::render::terrain_shading::TerrainSettings;
+use crate::terrain::horizon_map::HorizonMap;
 use crate::terrain::sun::{Sun, Track, TrackKind};
 use crate::terrain::MinMaxMipmap;
 use glam::{Mat4, Vec3};
@@ -42,7 +43,9 @@ pub struct TerrainParams {
     pub cell_x: f32,
     pub cell_y: f32,
     pub tan_alpha: f32,
-    pub pad1: [u32; 3],
+    pub horizon_w: f32,
+    pub elevation_deg: f32,
+    pub has_horizon: u32,
 }
 
 /// The `TerrainFrame` uniform of `terrain_render.wgsl` (public for the layout test in
@@ -61,12 +64,23 @@ pub struct TerrainFrame {
     pub max_height_tint: f32,
 }
 
+/// The horizon maps on the GPU: all planes stay on the CPU; the two around the sun's azimuth
+/// are packed per texel into one storage buffer, uploaded again only when the sun's azimuth
+/// leaves their bracket (a sun moving in elevation, or within the bracket, costs nothing).
+struct HorizonGpu {
+    map: HorizonMap,
+    buffer: wgpu::Buffer,
+    /// The planes in `buffer`.
+    pair: Option<(usize, usize)>,
+}
+
 /// GPU state for one height map.
 pub struct TerrainRenderer {
     map_size: (u32, u32),
+    buffers: TerrainBuffers,
+    horizon: Option<HorizonGpu>,
     cell: [f32; 2],
     heights_range: (f32, f32),
-    params: wgpu::Buffer,
     params_cpu: TerrainParams,
     mask_pipeline: wgpu::ComputePipeline,
     mask_groups: [wgpu::BindGroup; 2],
@@ -125,30 +139,15 @@ impl TerrainRenderer {
             ..Default::default()
         };
         let params = compute::uniform(gpu, "terrain params", &params_cpu);
-        let terrain_entries = |layout: &wgpu::BindGroupLayout| {
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("terrain"),
-                layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: heights.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: mip_data.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: mip_levels.as_entire_binding(),
-                    },
-                ],
-            })
+        let buffers = TerrainBuffers {
+            params,
+            heights,
+            mip_data,
+            mip_levels,
+            // A placeholder until horizon maps are set (`has_horizon` = 0).
+            horizon_pair: compute::storage(gpu, "horizon pair", &[0u32]),
         };
+        let terrain_entries = |layout: &wgpu::BindGroupLayout| buffers.bind(gpu, layout);
 
         let mask_pipeline = compute::pipeline(gpu, "terrain_mask.wgsl", "main")?;
         let mask_params = compute::uniform(gpu, "mask params", &[0u32; 4]);
@@ -234,9 +233,10 @@ impl TerrainRenderer {
         let (lo, hi) = map.min_max();
         let mut r = TerrainRenderer {
             map_size: (map.width as u32, map.height as u32),
+            buffers,
+            horizon: None,
             cell: [map.cell_size[0] as f32, map.cell_size[1] as f32],
             heights_range: (lo, hi),
-            params,
             params_cpu,
             mask_pipeline,
             mask_groups,
@@ -282,9 +282,61 @@ impl TerrainRenderer {
         (p.sin_elevation0, p.cos_elevation0) = (se as f32, ce as f32);
         let (sa, ca) = sun.azimuth_deg.to_radians().sin_cos();
         (p.sin_azimuth, p.cos_azimuth) = (sa as f32, ca as f32);
-        gpu.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(p));
+        p.elevation_deg = sun.elevation_deg as f32;
         self.sun = sun;
+        self.upload_horizon(gpu);
+        gpu.queue.write_buffer(
+            &self.buffers.params,
+            0,
+            bytemuck::bytes_of(&self.params_cpu),
+        );
+    }
+
+    /// Use `hm` (of this map) for hard shadows when [`TerrainSettings::horizon`] is set and for
+    /// [`Self::shadow_mask_horizon`].
+    pub fn set_horizon(&mut self, gpu: &Gpu, hm: HorizonMap) -> Result<()> {
+        if (hm.width, hm.height) != (self.map_size.0 as usize, self.map_size.1 as usize) {
+            return Err(Error::Internal(
+                "horizon map and height map sizes differ".into(),
+            ));
+        }
+        let buffer = compute::output(gpu, "horizon pair", (hm.width * hm.height * 4) as u64);
+        self.buffers.horizon_pair = buffer.clone();
+        self.horizon = Some(HorizonGpu {
+            map: hm,
+            buffer,
+            pair: None,
+        });
+        self.mask_groups[1] = self
+            .buffers
+            .bind(gpu, &self.mask_pipeline.get_bind_group_layout(1));
+        self.render_groups[1] = self
+            .buffers
+            .bind(gpu, &self.render_pipeline.get_bind_group_layout(1));
+        self.params_cpu.has_horizon = 1;
+        self.set_sun(gpu, self.sun);
+        Ok(())
+    }
+
+    /// Whether horizon maps are set.
+    pub fn has_horizon(&self) -> bool {
+        self.horizon.is_some()
+    }
+
+    /// Bracket the sun's azimuth in the horizon map and upload the pair of planes if it
+    /// changed; sets the interpolation weight.
+    fn upload_horizon(&mut self, gpu: &Gpu) {
+        let Some(h) = self.horizon.as_mut() else {
+            return;
+        };
+        let (k0, k1, w) = h.map.bracket(self.sun.azimuth_deg);
+        self.params_cpu.horizon_w = w as f32;
+        if h.pair != Some((k0, k1)) {
+            let packed = h.map.packed_pair(k0, k1);
+            gpu.queue
+                .write_buffer(&h.buffer, 0, bytemuck::cast_slice(&packed));
+            h.pair = Some((k0, k1));
+        }
     }
 
     /// Soft-shadow knobs: the sun's angular radius (degrees) and the planet radius (metres,
@@ -293,8 +345,17 @@ impl TerrainRenderer {
         self.params_cpu.alpha = sun_radius_deg.to_radians() as f32;
         self.params_cpu.tan_alpha = sun_radius_deg.to_radians().tan() as f32;
         self.params_cpu.planet_radius = planet_radius_m.unwrap_or(0.0) as f32;
-        gpu.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&self.params_cpu));
+        gpu.queue.write_buffer(
+            &self.buffers.params,
+            0,
+            bytemuck::bytes_of(&self.params_cpu),
+        );
+    }
+
+    /// The hard-shadow mask of every texel from the horizon maps (the accelerated traversal's
+    /// when none are set), computed on the GPU.
+    pub fn shadow_mask_horizon(&self, gpu: &Gpu) -> Result<Vec<bool>> {
+        Ok(self.run_mask(gpu, 3)?.iter().map(|&w| w != 0).collect())
     }
 
     /// The hard-shadow mask of every texel (row-major, true = shadow), computed on the GPU.
@@ -382,7 +443,10 @@ impl TerrainRenderer {
                 s.sun_strength,
             ],
             exposure: s.exposure,
-            flags: s.shadows as u32 | (s.fog as u32) << 1 | (s.soft as u32) << 2,
+            flags: s.shadows as u32
+                | (s.fog as u32) << 1
+                | (s.soft as u32) << 2
+                | ((s.horizon && self.horizon.is_some()) as u32) << 3,
             min_height: self.heights_range.0,
             max_height_tint: self.heights_range.1,
         };
@@ -414,6 +478,40 @@ impl TerrainRenderer {
         let view = crate::render::camera::look_at(eye, eye - Vec3::Y, Vec3::NEG_Z);
         let proj = crate::render::camera::orthographic(0.0, w, -h, 0.0, 0.0, 2.0 * top + 1.0);
         (proj * view, eye)
+    }
+}
+
+/// The storage buffers of group 1 (`terrain_shadow.wgsl`).
+struct TerrainBuffers {
+    params: wgpu::Buffer,
+    heights: wgpu::Buffer,
+    mip_data: wgpu::Buffer,
+    mip_levels: wgpu::Buffer,
+    horizon_pair: wgpu::Buffer,
+}
+
+impl TerrainBuffers {
+    /// Group 1 of a pipeline that includes `terrain_shadow.wgsl`.
+    fn bind(&self, gpu: &Gpu, layout: &wgpu::BindGroupLayout) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry> = [
+            &self.params,
+            &self.heights,
+            &self.mip_data,
+            &self.mip_levels,
+            &self.horizon_pair,
+        ]
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("terrain"),
+            layout,
+            entries: &entries,
+        })
     }
 }
 

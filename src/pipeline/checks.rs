@@ -50,6 +50,17 @@ pub fn percent(v: f64) -> Result<f64, String> {
     }
 }
 
+/// Horizon-map azimuths: 1..=360.
+pub fn horizon_directions(v: u32) -> Result<u32, String> {
+    if (1..=360).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "out of range: {v} (horizon directions are 1..=360)"
+        ))
+    }
+}
+
 /// Reorder passes: 0, 1 or 2.
 pub fn reorder_passes(v: u8) -> Result<u8, String> {
     if v <= 2 {
@@ -136,6 +147,9 @@ pub mod arg {
     pub fn reorder_passes(s: &str) -> Result<u8, String> {
         parse_checked(s, super::reorder_passes)
     }
+    pub fn horizon_directions(s: &str) -> Result<u32, String> {
+        parse_checked(s, super::horizon_directions)
+    }
     pub fn texture_size(s: &str) -> Result<u32, String> {
         parse_checked(s, super::texture_size)
     }
@@ -219,6 +233,9 @@ pub mod de {
     }
     pub fn reorder_passes<'de, D: Deserializer<'de>>(d: D) -> Result<u8, D::Error> {
         with(d, super::reorder_passes)
+    }
+    pub fn horizon_directions<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+        with(d, super::horizon_directions)
     }
     pub fn texture_size<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
         with(d, super::texture_size)

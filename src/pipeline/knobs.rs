@@ -10,6 +10,7 @@ use crate::compress::reorder::{ReorderMethod, ReorderMetric, ReorderOptions};
 use crate::radiosity::formfactor::{Estimator, FormFactorParams};
 use crate::radiosity::transport::{Bounces, Power};
 use crate::radiosity::voxelize::{Resolution, VoxelizeParams};
+use crate::terrain::horizon_map::HorizonSettings;
 use serde::{Deserialize, Serialize};
 
 /// Knobs of `Voxelize(...)`.
@@ -229,6 +230,53 @@ impl EncodeKnobs {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MinmaxMipmapKnobs {}
+
+/// Knobs of `HorizonMaps(...)`: horizon angles toward N azimuths at every texel
+/// (`horizon_maps.npy`), for shadows of any sun in O(1) per pixel and the sky-view factor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HorizonMapsKnobs {
+    /// Azimuths (near-uniform rational directions), 1..=360; default 64. The file holds
+    /// 2·N bytes per texel.
+    #[serde(
+        default = "default_horizon_directions",
+        deserialize_with = "checks::de::horizon_directions"
+    )]
+    pub directions: u32,
+    /// Planet radius in metres for curved ground (Earth: 6371000); absent: flat ground.
+    #[serde(
+        default,
+        deserialize_with = "checks::de::optional_positive_f64",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub planet_radius: Option<f64>,
+}
+
+/// The default number of horizon azimuths.
+pub const DEFAULT_HORIZON_DIRECTIONS: u32 = 64;
+
+fn default_horizon_directions() -> u32 {
+    DEFAULT_HORIZON_DIRECTIONS
+}
+
+impl Default for HorizonMapsKnobs {
+    fn default() -> Self {
+        HorizonMapsKnobs {
+            directions: DEFAULT_HORIZON_DIRECTIONS,
+            planet_radius: None,
+        }
+    }
+}
+
+impl HorizonMapsKnobs {
+    /// The settings of [`crate::terrain::horizon_map::HorizonMap::build`].
+    pub fn settings(&self) -> HorizonSettings {
+        HorizonSettings {
+            directions: self.directions as usize,
+            planet_radius: self.planet_radius,
+        }
+    }
+}
 
 impl VoxelizeKnobs {
     /// The parameters of [`crate::radiosity::voxelize::voxelize`].

@@ -2,7 +2,8 @@
 //! order. How a stage runs lives in `crate::bake::stages`.
 
 use super::knobs::{
-    EncodeKnobs, FormFactorsKnobs, MinmaxMipmapKnobs, ReorderKnobs, TransportKnobs, VoxelizeKnobs,
+    EncodeKnobs, FormFactorsKnobs, HorizonMapsKnobs, MinmaxMipmapKnobs, ReorderKnobs,
+    TransportKnobs, VoxelizeKnobs,
 };
 use super::Pipeline;
 use crate::error::{Error, Result};
@@ -24,6 +25,8 @@ pub enum Stage {
     Encode(EncodeKnobs),
     /// Min/max mipmap of a height map (`minmax_mipmap.exr`).
     MinmaxMipmap(MinmaxMipmapKnobs),
+    /// Horizon maps of a height map (`horizon_maps.npy`, `horizon_directions.npy`).
+    HorizonMaps(HorizonMapsKnobs),
 }
 
 /// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
@@ -36,6 +39,7 @@ pub enum StageKind {
     Reorder,
     Encode,
     MinmaxMipmap,
+    HorizonMaps,
 }
 
 impl Stage {
@@ -48,6 +52,7 @@ impl Stage {
             Stage::Reorder(_) => StageKind::Reorder,
             Stage::Encode(_) => StageKind::Encode,
             Stage::MinmaxMipmap(_) => StageKind::MinmaxMipmap,
+            Stage::HorizonMaps(_) => StageKind::HorizonMaps,
         }
     }
 }
@@ -62,6 +67,7 @@ impl StageKind {
             StageKind::Reorder => "reorder",
             StageKind::Encode => "encode",
             StageKind::MinmaxMipmap => "minmax_mipmap",
+            StageKind::HorizonMaps => "horizon_maps",
         }
     }
 
@@ -70,7 +76,7 @@ impl StageKind {
         match self {
             StageKind::Voxelize | StageKind::FormFactors | StageKind::Transport => "scene",
             StageKind::Reorder | StageKind::Encode => "scene",
-            StageKind::MinmaxMipmap => "heightmap",
+            StageKind::MinmaxMipmap | StageKind::HorizonMaps => "heightmap",
         }
     }
 
@@ -81,7 +87,7 @@ impl StageKind {
             StageKind::FormFactors => &[StageKind::Voxelize],
             StageKind::Transport => &[StageKind::Voxelize, StageKind::FormFactors],
             StageKind::Reorder | StageKind::Encode => &[StageKind::Transport],
-            StageKind::MinmaxMipmap => &[],
+            StageKind::MinmaxMipmap | StageKind::HorizonMaps => &[],
         }
     }
 }

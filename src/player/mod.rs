@@ -135,6 +135,22 @@ impl Player {
         }
     }
 
+    /// How a terrain frame with settings `s` computes its shadows (None for other scenes).
+    pub fn terrain_shadows(&self, s: &FrameSettings) -> Option<&'static str> {
+        let Player::Terrain(t) = self else {
+            return None;
+        };
+        Some(if !s.shadows {
+            "none"
+        } else if s.soft_shadows {
+            "soft"
+        } else if s.horizon_shadows && t.renderer.has_horizon() {
+            "horizon_maps"
+        } else {
+            "traversal"
+        })
+    }
+
     /// Render one frame into the player's target.
     pub fn render(
         &mut self,
@@ -149,6 +165,7 @@ impl Player {
                 t.settings.exposure = s.exposure;
                 t.settings.shadows = s.shadows;
                 t.settings.soft = s.soft_shadows;
+                t.settings.horizon = s.horizon_shadows;
                 t.settings.fog = s.fog;
                 t.render(gpu, camera, timer)
             }

@@ -1,5 +1,6 @@
 //! Height-map bakes at runtime: the height field as a mesh with per-pixel relief shadows (hard
-//! by the accelerated traversal, or soft by branch-and-bound) over the min/max mipmap, shadow
+//! from the horizon maps when baked, else by the accelerated traversal over the min/max mipmap;
+//! or soft by branch-and-bound), shadow
 //! brightness k_shadow, aerial perspective; the sun moves freely.
 
 use crate::baked::{self, Manifest};
@@ -23,7 +24,8 @@ pub struct TerrainPlayer {
 }
 
 impl TerrainPlayer {
-    /// Load `heightmap.exr` and `minmax_mipmap.exr` (built here when the bake has none).
+    /// Load `heightmap.exr`, `minmax_mipmap.exr` (built here when the bake has none) and the
+    /// horizon maps when the bake has them.
     pub fn load(
         gpu: &Gpu,
         dir: &Path,
@@ -48,7 +50,11 @@ impl TerrainPlayer {
                 format!("{} is {}x{}", baked::heightmap::FILE, map.width, map.height),
             ));
         }
-        let renderer = TerrainRenderer::new(gpu, &map, &mip, width, height, None)?;
+        let mut renderer = TerrainRenderer::new(gpu, &map, &mip, width, height, None)?;
+        if manifest.file(baked::horizon::FILE).is_some() {
+            let hm = baked::horizon::read(dir, manifest, (map.width, map.height), map.cell_size)?;
+            renderer.set_horizon(gpu, hm)?;
+        }
         Ok(TerrainPlayer {
             map,
             mip,

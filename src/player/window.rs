@@ -268,6 +268,7 @@ impl App {
                 "4" => self.plan.settings.emission = !self.plan.settings.emission,
                 "5" => self.plan.settings.soft_shadows = !self.plan.settings.soft_shadows,
                 "6" => self.plan.settings.fog = !self.plan.settings.fog,
+                "7" => self.plan.settings.horizon_shadows = !self.plan.settings.horizon_shadows,
                 "[" => self.plan.settings.exposure /= 1.25,
                 "]" => self.plan.settings.exposure *= 1.25,
                 _ => {}

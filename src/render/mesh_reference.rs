@@ -20,6 +20,9 @@ pub struct FrameSettings {
     pub emission: bool,
     /// Terrain: soft shadows of the sun's disc instead of hard ones.
     pub soft_shadows: bool,
+    /// Terrain: hard shadows from the bake's horizon maps when it has them (else the
+    /// traversal over the min/max mipmap).
+    pub horizon_shadows: bool,
     /// Terrain: aerial perspective.
     pub fog: bool,
     /// Display colour behind the scene (sRGB, 0..1).
@@ -36,6 +39,7 @@ impl Default for FrameSettings {
             shadows: true,
             emission: true,
             soft_shadows: false,
+            horizon_shadows: true,
             fog: true,
             background: [0.0; 3],
         }

@@ -21,6 +21,9 @@ pub struct TerrainSettings {
     pub shadows: bool,
     /// Soft shadows of the sun's disc (branch-and-bound) instead of hard ones.
     pub soft: bool,
+    /// Hard shadows from the horizon maps (O(1) per pixel, interpolated between stored
+    /// azimuths) when the bake has them, instead of the traversal over the min/max mipmap.
+    pub horizon: bool,
     /// Aerial perspective (the function-based geometry paper's scattered light, docs/algorithms.md §6), per pixel.
     pub fog: bool,
     /// Extinction β_ext per metre.
@@ -43,6 +46,7 @@ impl Default for TerrainSettings {
             vertical_exaggeration: 3.0,
             shadows: true,
             soft: false,
+            horizon: true,
             fog: true,
             fog_extinction: 2.5e-6,
             fog_albedo: 0.6,

@@ -15,10 +15,21 @@
 //! same for all pixels. P's samples are its period's samples (its own texel with the half
 //! transit from the centre) and every sample of P′'s track except P′'s own start sample, which
 //! P's track crosses in full. A line of pixels P₀, P₀ + (a, b), … is processed from its far
-//! end: each pixel asks the hull of everything beyond its period for the tangent from
-//! (τ_P, z_P) (binary search: slopes to the vertices of an upper hull are unimodal from a point
-//! on its left), takes the maximum with its period's samples, then pushes its period (with
-//! its own texel's full transit) for the pixels behind it. O(period) per pixel and azimuth.
+//! end: each pixel pushes its period's samples (decreasing τ) onto the line's upper hull,
+//! asks the hull for the tangent from (τ_P, z_P) — popping the vertices before the tangent
+//! point, which lie under the chord from P and can serve no pixel further back (Timonen &
+//! Westerholm's amortised O(1) query) — takes the maximum with its own texel's half transit,
+//! then pushes its own texel's full transit (≈ P itself) for the pixels behind it.
+//! O(period) per pixel and azimuth: |a| + |b| samples, each a bilinear stencil and a hull push.
+//!
+//! **Curved planet.** A sample Δt ahead drops by κΔt² (κ = metres_per_t²/(2R), the parabolic
+//! approximation of a sphere of radius R), which is not a translate-invariant change of the
+//! heights; but with f(τ) = h(τ) − κτ² on the line's own coordinate τ,
+//! `(h_s − κ(τ_s − τ_P)² − z_P)/(τ_s − τ_P) = (f_s − f_P)/(τ_s − τ_P) + 2κτ_P`: the same hull
+//! over f, the tangent shifted by 2κτ_P. [`horizon_exact_curved`] is the reference on the
+//! sphere itself (the soft-shadow model's geometry, where distances and drops scale by
+//! (R + h)/R); the parabola — the usual GIS model, as in GRASS r.horizon — differs from it by a
+//! relative h/R of the slope: 0.0092° at worst on Big Tujunga on Earth (tests/terrain_horizon.rs).
 //!
 //! The azimuths are close to, not exactly, uniform: within a fifth of the spacing (the actual
 //! ones are stored with the map). The samples are bit for bit the walk's up to the rounding
@@ -147,6 +158,35 @@ pub fn horizon_exact(map: &HeightMap, track: &Track, col: usize, row: usize, max
     (best / track.metres_per_t).atan().to_degrees()
 }
 
+/// The exact horizon angle (degrees) on a planet of radius `radius` metres: the same samples,
+/// each seen at its elevation above P's horizontal plane on the sphere
+/// ([`super::soft::model::slope`], the soft-shadow model's geometry), not the sweep's
+/// parabolic drop. Stops at the map's edge, or once `best` ≥ 0 and the map's maximum cannot be
+/// steeper ([`super::soft::model::beyond_reach`]).
+pub fn horizon_exact_curved(
+    map: &HeightMap,
+    track: &Track,
+    (col, row): (usize, usize),
+    (min, max): (f32, f32),
+    radius: f64,
+) -> f64 {
+    use super::soft::model::{beyond_reach, slope};
+    let zp = map.heights[row * map.width + col] as f64;
+    let m = track.metres_per_t;
+    let walk = TrackWalk::new(map, track, col, row);
+    let p = walk.start();
+    let mut best = f64::NEG_INFINITY;
+    for t in walk {
+        let reach = beyond_reach(max as f64, min as f64, zp, t.t_in * m, radius, best);
+        if best >= 0.0 && reach {
+            break;
+        }
+        let (t_mid, hq) = texel_sample(map, track, p, [t.ix, t.iy], t.t_in, t.t_out);
+        best = best.max(slope(hq, zp, t_mid * m, radius));
+    }
+    best.atan().to_degrees()
+}
+
 /// One texel of the period: offset from the pixel and transit times from its centre.
 #[derive(Clone, Copy, Debug)]
 struct PeriodTexel {
@@ -186,14 +226,18 @@ fn period(track: &Track, dir: &Direction) -> Vec<PeriodTexel> {
     }
 }
 
-/// Horizon angles (degrees, row-major) of every pixel along `dir`, by the line sweep.
-pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
+/// Horizon angles (degrees, row-major) of every pixel along `dir`, by the line sweep; on a
+/// planet of radius `planet_radius` metres when given (a sample d metres away drops by
+/// d²/(2R), the parabolic approximation of the sphere: see the module notes).
+pub fn horizon_sweep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
     let (w, h) = (map.width as i64, map.height as i64);
     let track = dir.track(map.cell_size);
     let per = period(&track, dir);
     let k = per.len() - 1; // texels before P′'s; per[k] is P′'s texel seen from P
                            // Line length in t: P′'s centre is at t = |(a, b)| (u is (a, b) normalised).
     let period_t = (dir.a as f64).hypot(dir.b as f64);
+    // The drop of a sample Δt away: κ·Δt² (t units: metres_per_t metres).
+    let kappa = planet_radius.map_or(0.0, |r| track.metres_per_t.powi(2) / (2.0 * r));
     let out: Vec<AtomicU32> = (0..(w * h) as usize).map(|_| AtomicU32::new(0)).collect();
     // Line starts: pixels P with P − (a, b) off the map.
     let starts: Vec<(i64, i64)> = (0..h)
@@ -208,7 +252,6 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
     starts.par_chunks(256).for_each(|chunk| {
         let mut hull: Vec<(f64, f64)> = Vec::new();
         let mut line: Vec<(i64, i64)> = Vec::new();
-        let mut samples: Vec<(f64, f64)> = Vec::with_capacity(k);
         for &(c0, r0) in chunk {
             line.clear();
             let (mut c, mut r) = (c0, r0);
@@ -221,50 +264,50 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction) -> Vec<f32> {
             for (n, &(c, r)) in line.iter().enumerate().rev() {
                 let tau = n as f64 * period_t;
                 let zp = map.heights[(r * w + c) as usize] as f64;
-                samples.clear();
+                // Heights on the line's parabola: f(τ) = h − κτ² (module notes).
+                let f = |ts: f64, hs: f64| (ts, hs - kappa * ts * ts);
+                // Push the period's samples (decreasing τ) before P's query, the own texel
+                // crossed in full (≈ P itself) after it.
                 let (own, full) = if stencils.fits(c, r, w, h) {
                     // Interior: the period's bilinear stencils, the same for every pixel.
                     let base = (r * w + c) as isize;
-                    for st in &stencils.period {
-                        samples.push((tau + st.t, st.eval(&map.heights, base, w as isize)));
+                    let hs = &map.heights;
+                    for st in stencils.period.iter().rev() {
+                        push(&mut hull, f(tau + st.t, st.eval(hs, base, w as isize)));
                     }
-                    let own = (
-                        stencils.own.t,
-                        stencils.own.eval(&map.heights, base, w as isize),
-                    );
-                    let full = stencils.full.eval(&map.heights, base, w as isize);
-                    (own, (tau + stencils.full.t, full))
+                    let own = (stencils.own.t, stencils.own.eval(hs, base, w as isize));
+                    (
+                        own,
+                        f(
+                            tau + stencils.full.t,
+                            stencils.full.eval(hs, base, w as isize),
+                        ),
+                    )
                 } else {
                     let p = [c as f64 + 0.5, r as f64 + 0.5];
-                    for t in &per[1..k] {
+                    // The period texels on the map (the walk stops at the edge).
+                    let on = per[1..k]
+                        .iter()
+                        .take_while(|t| inside(c + t.dx, r + t.dy))
+                        .count();
+                    for t in per[1..=on].iter().rev() {
                         let (x, y) = (c + t.dx, r + t.dy);
-                        if !inside(x, y) {
-                            break;
-                        }
                         let (tm, hq) = texel_sample(map, &track, p, [x, y], t.t_in, t.t_out);
-                        samples.push((tau + tm, hq));
+                        push(&mut hull, f(tau + tm, hq));
                     }
                     let own = texel_sample(map, &track, p, [c, r], 0.0, per[0].t_out);
-                    let f = per[k];
+                    let last = per[k];
                     let prev = [p[0] - dir.a as f64, p[1] - dir.b as f64];
-                    let (tm, hq) = texel_sample(map, &track, prev, [c, r], f.t_in, f.t_out);
-                    (own, (tau - period_t + tm, hq))
+                    let (tm, hq) = texel_sample(map, &track, prev, [c, r], last.t_in, last.t_out);
+                    (own, f(tau - period_t + tm, hq))
                 };
-                // The own texel's half transit, the rest of the period, and the hull beyond.
-                let mut best = (own.1 - zp) / own.0;
-                for &(ts, hs) in &samples {
-                    best = best.max((hs - zp) / (ts - tau));
-                }
-                if let Some(s) = tangent(&hull, tau, zp) {
-                    best = best.max(s);
+                // The own texel's half transit, then the tangent to everything beyond it.
+                let mut best = (own.1 - kappa * own.0 * own.0 - zp) / own.0;
+                if let Some(s) = tangent(&mut hull, tau, zp - kappa * tau * tau) {
+                    best = best.max(s + 2.0 * kappa * tau);
                 }
                 let deg = (best / track.metres_per_t).atan().to_degrees() as f32;
                 out[(r * w + c) as usize].store(deg.to_bits(), Ordering::Relaxed);
-                // Push this period for the pixels behind: samples in decreasing τ, then the
-                // own texel crossed in full by the previous pixel's track.
-                for &s in samples.iter().rev() {
-                    push(&mut hull, s);
-                }
                 push(&mut hull, full);
             }
         }
@@ -382,141 +425,15 @@ fn push(hull: &mut Vec<(f64, f64)>, q: (f64, f64)) {
     hull.push(q);
 }
 
-/// The steepest slope from (tau, z) to the hull's vertices (all to its right), by binary
-/// search over the unimodal slopes; None for an empty hull.
-fn tangent(hull: &[(f64, f64)], tau: f64, z: f64) -> Option<f64> {
-    if hull.is_empty() {
-        return None;
+/// The steepest slope from (tau, z) to the hull's vertices (all to its right), None for an
+/// empty hull. Pops the vertices before the tangent point: the caller then pushes a point at
+/// (tau, z) (to rounding), under whose chord to the tangent point they lie, so no later query
+/// from further left can need them (Timonen & Westerholm's amortised O(1) per query).
+fn tangent(hull: &mut Vec<(f64, f64)>, tau: f64, z: f64) -> Option<f64> {
+    let slope = |q: (f64, f64)| (q.1 - z) / (q.0 - tau);
+    // The last vertex is leftmost; slopes rise from it to the tangent point, then fall.
+    while hull.len() >= 2 && slope(hull[hull.len() - 1]) <= slope(hull[hull.len() - 2]) {
+        hull.pop();
     }
-    let slope = |i: usize| (hull[i].1 - z) / (hull[i].0 - tau);
-    // Index 0 is rightmost; slopes rise from the left end (last) to the tangent, then fall.
-    let (mut lo, mut hi) = (0usize, hull.len() - 1);
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        if slope(mid) >= slope(mid + 1) {
-            hi = mid;
-        } else {
-            lo = mid + 1;
-        }
-    }
-    Some(slope(lo))
-}
-
-/// Horizon angles for N directions, quantised to u16: angle = −90° + v·(180°/65535), an error
-/// of at most 0.0014° (half a step).
-#[derive(Clone, Debug, PartialEq)]
-pub struct HorizonMap {
-    pub width: usize,
-    pub height: usize,
-    /// Sorted by azimuth.
-    pub directions: Vec<Direction>,
-    /// One row-major plane per direction.
-    pub angles: Vec<Vec<u16>>,
-}
-
-/// Degrees per quantisation step of [`HorizonMap`].
-pub const STEP_DEG: f64 = 180.0 / 65535.0;
-
-/// Quantise a horizon angle in degrees (clamped to [−90, 90]).
-pub fn encode(deg: f64) -> u16 {
-    ((deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG).round() as u16
-}
-
-/// The angle in degrees of a quantised value.
-pub fn decode(v: u16) -> f64 {
-    -90.0 + v as f64 * STEP_DEG
-}
-
-impl HorizonMap {
-    /// The horizon map of `map` for `n` directions ([`directions`]), one sweep per direction.
-    pub fn build(map: &HeightMap, n: usize) -> HorizonMap {
-        let directions = directions(n, map.cell_size);
-        let angles = directions
-            .iter()
-            .map(|d| {
-                horizon_sweep(map, d)
-                    .iter()
-                    .map(|&a| encode(a as f64))
-                    .collect()
-            })
-            .collect();
-        HorizonMap {
-            width: map.width,
-            height: map.height,
-            directions,
-            angles,
-        }
-    }
-
-    /// The two stored directions around `azimuth` and the weight of the second (linear in
-    /// azimuth, on the circle).
-    fn bracket(&self, azimuth: f64) -> (usize, usize, f64) {
-        let n = self.directions.len();
-        let az = azimuth.rem_euclid(360.0);
-        let k1 = self
-            .directions
-            .iter()
-            .position(|d| d.azimuth_deg > az)
-            .unwrap_or(0);
-        let k0 = (k1 + n - 1) % n;
-        let (a0, a1) = (
-            self.directions[k0].azimuth_deg,
-            self.directions[k1].azimuth_deg,
-        );
-        let span = (a1 - a0).rem_euclid(360.0);
-        let w = if span == 0.0 {
-            0.0
-        } else {
-            (az - a0).rem_euclid(360.0) / span
-        };
-        (k0, k1, w)
-    }
-
-    /// Hard shadows for any sun in O(1) per pixel: shadowed when the elevation is below the
-    /// horizon interpolated between the two stored azimuths around the sun's.
-    pub fn shadow_mask(&self, sun: &super::sun::Sun) -> Vec<bool> {
-        let n = self.width * self.height;
-        if sun.elevation_deg >= 90.0 {
-            return vec![false; n];
-        }
-        if sun.elevation_deg <= 0.0 {
-            return vec![true; n];
-        }
-        let (k0, k1, w) = self.bracket(sun.azimuth_deg);
-        let (p0, p1) = (&self.angles[k0], &self.angles[k1]);
-        (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let h = decode(p0[i]) * (1.0 - w) + decode(p1[i]) * w;
-                sun.elevation_deg < h
-            })
-            .collect()
-    }
-
-    /// The sky-view factor of a horizontal surface: the part of the sky hemisphere's
-    /// projected area above the horizon, Σ_k w_k (1 − sin max(H_k, 0)), each direction weighted
-    /// by half the azimuth gap to its neighbours (1 on flat ground; 1 − sin H under a uniform
-    /// horizon H).
-    pub fn sky_view(&self) -> Vec<f32> {
-        let n = self.directions.len();
-        let weights: Vec<f64> = (0..n)
-            .map(|k| {
-                let prev = self.directions[(k + n - 1) % n].azimuth_deg;
-                let next = self.directions[(k + 1) % n].azimuth_deg;
-                let gap = (next - prev).rem_euclid(360.0);
-                let gap = if n == 1 { 720.0 } else { gap };
-                0.5 * gap / 360.0
-            })
-            .collect();
-        (0..self.width * self.height)
-            .into_par_iter()
-            .map(|i| {
-                let mut v = 0.0;
-                for (k, w) in weights.iter().enumerate() {
-                    v += w * (1.0 - decode(self.angles[k][i]).max(0.0).to_radians().sin());
-                }
-                v as f32
-            })
-            .collect()
-    }
+    hull.last().map(|&q| slope(q))
 }

@@ -8,6 +8,7 @@
 //! - [`sweep`]: hard shadows by a certified sweep (bounds along bands, witnesses, exact
 //!   traversal for the rest), equal to the exact answer;
 //! - [`horizon`]: horizon angles for N azimuths by a line sweep with convex hulls;
+//! - [`horizon_map`]: the quantised horizon map: sky-view factor, O(1) shadows for any sun;
 //! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
 //! - [`relief`]: whole-image shadow masks and shaded relief;
 //! - [`soft`]: soft shadows of the sun's disc on flat or curved terrain (four methods);
@@ -23,6 +24,7 @@ pub mod exact_traversal;
 pub mod generate;
 pub mod hard_f32;
 pub mod horizon;
+pub mod horizon_map;
 pub use crate::heightmap::minmax_mipmap;
 pub mod relief;
 pub mod soft;

@@ -14,7 +14,7 @@
 //! mass; on the surface DNI · max(0, n·s), n from central differences of the heights. Diffuse
 //! and reflected light are not modelled (GRASS r.sun and Whitebox add them).
 
-use super::horizon::HorizonMap;
+use super::horizon_map::{horizon_at, HorizonMap};
 use super::solar::{solar_position, Instant, Place, SpaOptions};
 use super::sun::Sun;
 use crate::error::{Error, Result};
@@ -73,39 +73,71 @@ pub fn clear_sky_dni(elevation_deg: f64) -> f64 {
 }
 
 /// Hours of direct sun per texel, and the direct-beam energy on the surface (Wh/m²) when
-/// `insolation` is set.
+/// `insolation` is set: each step above the horizon is [`HorizonMap::shadow_mask`]'s test,
+/// evaluated for a block of texels at a time over all steps (the planes of a block stay in
+/// cache), summed in f64.
 pub fn sunlight(
     map: &HeightMap,
     horizons: &HorizonMap,
     steps: &[Step],
     insolation: bool,
 ) -> (Vec<f32>, Option<Vec<f32>>) {
-    let n = map.width * map.height;
-    let mut hours = vec![0.0f64; n];
-    let mut energy = insolation.then(|| vec![0.0f64; n]);
-    let normals = insolation.then(|| normals(map));
-    for s in steps.iter().filter(|s| s.sun.elevation_deg > 0.0) {
-        let shadow = horizons.shadow_mask(&s.sun);
-        hours
-            .par_iter_mut()
-            .zip(&shadow)
-            .for_each(|(h, &sh)| *h += if sh { 0.0 } else { s.hours });
-        if let (Some(e), Some(nm)) = (energy.as_mut(), normals.as_ref()) {
-            let d = s.sun.direction();
-            let dni = clear_sky_dni(s.sun.elevation_deg);
-            e.par_iter_mut()
-                .zip(&shadow)
-                .zip(nm)
-                .for_each(|((e, &sh), n)| {
-                    if !sh {
-                        let c = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-                        *e += dni * c.max(0.0) * s.hours;
-                    }
-                });
-        }
+    /// A step with the sun up: its bracket in the map and its beam (DNI · hours · direction).
+    struct Lit {
+        k0: usize,
+        k1: usize,
+        w: f64,
+        elevation: f64,
+        hours: f64,
+        beam: [f64; 3],
     }
-    let f = |v: Vec<f64>| v.into_iter().map(|x| x as f32).collect();
-    (f(hours), energy.map(f))
+    let lit: Vec<Lit> = steps
+        .iter()
+        .filter(|s| s.sun.elevation_deg > 0.0)
+        .map(|s| {
+            let (k0, k1, w) = horizons.bracket(s.sun.azimuth_deg);
+            let d = s.sun.direction();
+            let e = clear_sky_dni(s.sun.elevation_deg) * s.hours;
+            Lit {
+                k0,
+                k1,
+                w,
+                elevation: s.sun.elevation_deg,
+                hours: s.hours,
+                beam: [d[0] * e, d[1] * e, d[2] * e],
+            }
+        })
+        .collect();
+    const BLOCK: usize = 4096;
+    let n = map.width * map.height;
+    let normals = insolation.then(|| normals(map));
+    let blocks: Vec<(Vec<f32>, Vec<f32>)> = (0..n.div_ceil(BLOCK))
+        .into_par_iter()
+        .map(|b| {
+            let range = b * BLOCK..((b + 1) * BLOCK).min(n);
+            let len = range.len();
+            let (mut hours, mut energy) = (vec![0.0f64; len], vec![0.0f64; len]);
+            for s in &lit {
+                let p0 = &horizons.angles[s.k0][range.clone()];
+                let p1 = &horizons.angles[s.k1][range.clone()];
+                for i in 0..len {
+                    if s.elevation >= horizon_at(p0[i], p1[i], s.w) {
+                        hours[i] += s.hours;
+                        if let Some(nm) = &normals {
+                            let v = nm[range.start + i];
+                            let c = v[0] * s.beam[0] + v[1] * s.beam[1] + v[2] * s.beam[2];
+                            energy[i] += c.max(0.0);
+                        }
+                    }
+                }
+            }
+            let f = |v: Vec<f64>| v.into_iter().map(|x| x as f32).collect();
+            (f(hours), f(energy))
+        })
+        .collect();
+    let hours = blocks.iter().flat_map(|b| b.0.iter().copied()).collect();
+    let energy = insolation.then(|| blocks.iter().flat_map(|b| b.1.iter().copied()).collect());
+    (hours, energy)
 }
 
 /// Unit surface normals (x east, y north, z up) from central differences (one-sided at the

@@ -37,6 +37,7 @@ pub fn runner(stage: &Stage) -> &dyn StageRun {
         Stage::Reorder(k) => k,
         Stage::Encode(k) => k,
         Stage::MinmaxMipmap(k) => k,
+        Stage::HorizonMaps(k) => k,
     }
 }
 

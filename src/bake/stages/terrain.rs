@@ -1,12 +1,13 @@
-//! The height-map stages: `minmax_mipmap`.
+//! The height-map stages: `minmax_mipmap`, `horizon_maps`.
 
 use super::{record, StageRun};
 use crate::bake::estimate::{PlanState, PlannedStage};
 use crate::bake::workspace::Workspace;
 use crate::baked::{self, BakeTransaction, StageRecord};
 use crate::error::Result;
-use crate::pipeline::knobs::MinmaxMipmapKnobs;
+use crate::pipeline::knobs::{HorizonMapsKnobs, MinmaxMipmapKnobs};
 use crate::progress::Progress;
+use crate::terrain::horizon_map::HorizonMap;
 use crate::terrain::minmax_mipmap::{level_sizes, MinMaxMipmap};
 
 impl StageRun for MinmaxMipmapKnobs {
@@ -49,6 +50,64 @@ impl StageRun for MinmaxMipmapKnobs {
             peak_bytes: bytes * 2,
             output_bytes: bytes / 2,
             notes: format!("{} levels, {} texels (max, min f32)", sizes.len(), texels),
+        }
+    }
+}
+
+impl StageRun for HorizonMapsKnobs {
+    fn run(
+        &self,
+        ws: &mut Workspace,
+        txn: &mut BakeTransaction,
+        progress: &dyn Progress,
+    ) -> Result<StageRecord> {
+        let settings = self.settings();
+        progress.begin(baked::horizon::STAGE, settings.directions as u64);
+        let hm = HorizonMap::build_with_progress(ws.heightmap()?, &settings, progress);
+        progress.finish();
+        baked::horizon::write(txn, &hm)?;
+        let mut rec = record(
+            baked::horizon::STAGE,
+            &[baked::horizon::FILE, baked::horizon::DIRECTIONS],
+        );
+        rec.report
+            .insert("directions".into(), hm.directions.len() as f64);
+        rec.report
+            .insert("planet_radius_m".into(), hm.planet_radius.unwrap_or(0.0));
+        let worst = hm
+            .directions
+            .iter()
+            .enumerate()
+            .map(|(k, d)| {
+                let want = k as f64 * 360.0 / hm.directions.len() as f64;
+                let e = (d.azimuth_deg - want).rem_euclid(360.0);
+                e.min(360.0 - e)
+            })
+            .fold(0.0f64, f64::max);
+        rec.report.insert("azimuth_max_offset_deg".into(), worst);
+        rec.facts.insert(
+            "layout".into(),
+            "horizon_maps.npy: u16 [N, H, W], angle = -90 + v*180/65535 degrees above the \
+             horizontal toward direction k; horizon_directions.npy: i32 [N, 2] texel steps \
+             (a east, b south), sorted by azimuth"
+                .into(),
+        );
+        Ok(rec)
+    }
+
+    fn estimate(&self, state: &mut PlanState) -> PlannedStage {
+        let (w, h) = state.map_size;
+        let texels = w.max(1) * h.max(1);
+        let n = self.directions as u64;
+        let planes = texels * n * 2;
+        // The planes held until written, one sweep's f32 angles, its line list and the written
+        // file's buffer.
+        let peak = planes + texels * 4 + texels * 16;
+        PlannedStage {
+            stage: baked::horizon::STAGE.into(),
+            peak_bytes: peak,
+            output_bytes: planes + n * 8,
+            notes: format!("{n} directions x {texels} texels, u16"),
         }
     }
 }

@@ -9,8 +9,10 @@ use relume::baked::images::{self, check_extension};
 use relume::error::{exit, Error};
 use relume::heightmap::georef::write_geotiff_f32;
 use relume::heightmap::{HeightMap, HeightMapInfo};
+use relume::pipeline::checks::arg;
+use relume::pipeline::knobs::{HorizonMapsKnobs, DEFAULT_HORIZON_DIRECTIONS};
 use relume::progress::Progress;
-use relume::terrain::horizon::{decode, HorizonMap};
+use relume::terrain::horizon_map::{decode, HorizonMap, HorizonSettings};
 use relume::terrain::solar::Instant;
 use relume::terrain::sunlight::{day_steps, sunlight};
 use relume::Result;
@@ -19,13 +21,26 @@ use std::path::{Path, PathBuf};
 
 const NODATA: f64 = -9999.0;
 
+/// The horizon map's settings from the flags (checked by their parsers), else the stage's
+/// defaults.
+fn horizon_settings(directions: Option<u32>, planet_radius: Option<f64>) -> HorizonSettings {
+    HorizonMapsKnobs {
+        directions: directions.unwrap_or(DEFAULT_HORIZON_DIRECTIONS),
+        planet_radius,
+    }
+    .settings()
+}
+
 #[derive(Args)]
 pub struct HorizonArgs {
     #[command(flatten)]
     pub map: MapArgs,
-    /// Number of azimuths (near-uniform rational directions; their exact azimuths are reported)
-    #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=360))]
-    pub directions: u32,
+    /// Number of azimuths, 1..=360 (near-uniform rational directions; their exact azimuths are reported) [default: 64]
+    #[arg(long, value_name = "N", value_parser = arg::horizon_directions)]
+    pub directions: Option<u32>,
+    /// Planet radius in metres for curved ground (Earth: 6371000; default: flat)
+    #[arg(long, value_name = "M", value_parser = arg::positive_f64)]
+    pub planet_radius: Option<f64>,
     /// Sky-view factor to write (.tif GeoTIFF f32, or .exr)
     #[arg(long, value_name = "SVF.tif")]
     pub sky_view: Option<PathBuf>,
@@ -50,9 +65,12 @@ pub struct SunlightArgs {
     /// Longitude in degrees (default: the GeoTIFF's centre)
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub lon: Option<f64>,
-    /// Horizon azimuths used for the shadows
-    #[arg(long, value_name = "N", default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=360))]
-    pub directions: u32,
+    /// Horizon azimuths used for the shadows, 1..=360 [default: 64]
+    #[arg(long, value_name = "N", value_parser = arg::horizon_directions)]
+    pub directions: Option<u32>,
+    /// Planet radius in metres for curved ground (Earth: 6371000; default: flat)
+    #[arg(long, value_name = "M", value_parser = arg::positive_f64)]
+    pub planet_radius: Option<f64>,
     /// Hours of direct sun to write (.tif GeoTIFF f32, or .exr)
     #[arg(long, value_name = "HOURS.tif")]
     pub out: PathBuf,
@@ -90,12 +108,13 @@ pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i
             "nothing to write: give --sky-view SVF.tif and/or --out DIR",
         ));
     }
+    let settings = horizon_settings(args.directions, args.planet_radius);
     ui.begin("load", 0);
     let (map, info) = load_map(&args.map)?;
     ui.finish();
     ui.begin("horizon", 0);
     let t0 = std::time::Instant::now();
-    let hm = HorizonMap::build(&map, args.directions as usize);
+    let hm = HorizonMap::build(&map, &settings);
     let seconds = t0.elapsed().as_secs_f64();
     ui.finish();
     if let Some(p) = &args.sky_view {
@@ -113,7 +132,8 @@ pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i
         print_json(&json!({
                 "input": args.map.input.display().to_string(),
                 "width": map.width, "height": map.height,
-                "directions": hm.directions, "seconds": seconds,
+                "directions": hm.directions, "planet_radius": hm.planet_radius,
+                "seconds": seconds,
                 "sky_view": args.sky_view.as_ref().map(|p| p.display().to_string()),
                 "out": args.out.as_ref().map(|p| p.display().to_string()),
         }));
@@ -160,6 +180,7 @@ pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Re
         check_extension(p, &["tif", "tiff", "exr"])?;
     }
     let step = parse_step(&args.step)?;
+    let settings = horizon_settings(args.directions, args.planet_radius);
     let date = if args.date.len() == 10 {
         Instant::parse(&format!("{}T00:00:00Z", args.date))?
     } else {
@@ -178,7 +199,7 @@ pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Re
     let steps = day_steps(&date, &place, step, up)?;
     let t0 = std::time::Instant::now();
     ui.begin("horizon", 0);
-    let hm = HorizonMap::build(&map, args.directions as usize);
+    let hm = HorizonMap::build(&map, &settings);
     ui.finish();
     let horizon_s = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();

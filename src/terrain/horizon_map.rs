@@ -1,0 +1,204 @@
+//! Horizon maps for N azimuths, quantised to u16 (built by [`super::horizon`]'s line sweep):
+//! the sky-view factor, and hard shadows for any sun in O(1) per pixel by interpolating the
+//! horizon between the two stored azimuths around the sun's (docs/algorithms.md §4.4).
+
+use super::horizon::{directions, horizon_sweep, Direction};
+use crate::heightmap::HeightMap;
+use rayon::prelude::*;
+
+/// What a horizon map is built for (the `horizon_maps` stage's knobs convert into it; their
+/// ranges are checked there: 1..=360 directions, a positive finite radius).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HorizonSettings {
+    /// Azimuths, near-uniform ([`directions`]).
+    pub directions: usize,
+    /// Planet radius in metres for curved ground (None = flat; Earth: 6371000).
+    pub planet_radius: Option<f64>,
+}
+
+impl Default for HorizonSettings {
+    fn default() -> Self {
+        HorizonSettings {
+            directions: 64,
+            planet_radius: None,
+        }
+    }
+}
+
+/// Horizon angles for N directions, quantised to u16: angle = −90° + v·(180°/65535), an error
+/// of at most 0.0014° (half a step).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HorizonMap {
+    pub width: usize,
+    pub height: usize,
+    /// Sorted by azimuth.
+    pub directions: Vec<Direction>,
+    /// One row-major plane per direction.
+    pub angles: Vec<Vec<u16>>,
+    /// The planet radius the map was built for (metres; None = flat ground).
+    pub planet_radius: Option<f64>,
+}
+
+/// The horizon (degrees) interpolated with weight `w` between quantised angles `v0` and `v1`:
+/// a sun below it is hidden.
+#[inline]
+pub fn horizon_at(v0: u16, v1: u16, w: f64) -> f64 {
+    decode(v0) * (1.0 - w) + decode(v1) * w
+}
+
+/// The horizon test of the GPU (`shadowed_horizon` in `shaders/terrain_shadow.wgsl`), its f32 twin: shadowed when
+/// `elevation_deg` is below the horizon interpolated with weight `w` between quantised angles
+/// `v0` and `v1`. It differs from [`HorizonMap::shadow_mask`]'s f64 test only when the
+/// elevation is within f32 rounding (≈ 1e-5°) of the interpolated horizon.
+pub fn shadowed_f32(v0: u16, v1: u16, w: f32, elevation_deg: f32) -> bool {
+    let step = STEP_DEG as f32;
+    let (h0, h1) = (v0 as f32 * step - 90.0, v1 as f32 * step - 90.0);
+    elevation_deg < h0 + (h1 - h0) * w
+}
+
+/// Degrees per quantisation step of [`HorizonMap`].
+pub const STEP_DEG: f64 = 180.0 / 65535.0;
+
+/// Quantise a horizon angle in degrees (clamped to [−90, 90]).
+pub fn encode(deg: f64) -> u16 {
+    ((deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG).round() as u16
+}
+
+/// The angle in degrees of a quantised value.
+pub fn decode(v: u16) -> f64 {
+    -90.0 + v as f64 * STEP_DEG
+}
+
+impl HorizonMap {
+    /// The horizon map of `map` (one sweep per direction). The settings must be in range.
+    pub fn build(map: &HeightMap, settings: &HorizonSettings) -> HorizonMap {
+        Self::build_with_progress(map, settings, &crate::progress::Silent)
+    }
+
+    /// [`HorizonMap::build`], advancing `progress` by one unit per direction (the caller
+    /// begins and finishes the phase).
+    pub fn build_with_progress(
+        map: &HeightMap,
+        settings: &HorizonSettings,
+        progress: &dyn crate::progress::Progress,
+    ) -> HorizonMap {
+        debug_assert!((1..=360).contains(&settings.directions));
+        let directions = directions(settings.directions, map.cell_size);
+        let angles = directions
+            .iter()
+            .map(|d| {
+                let plane = horizon_sweep(map, d, settings.planet_radius)
+                    .iter()
+                    .map(|&a| encode(a as f64))
+                    .collect();
+                progress.advance(1);
+                plane
+            })
+            .collect();
+        HorizonMap {
+            width: map.width,
+            height: map.height,
+            directions,
+            angles,
+            planet_radius: settings.planet_radius,
+        }
+    }
+
+    /// The two stored directions around `azimuth` and the weight of the second (linear in
+    /// azimuth, on the circle).
+    pub fn bracket(&self, azimuth: f64) -> (usize, usize, f64) {
+        let n = self.directions.len();
+        let az = azimuth.rem_euclid(360.0);
+        let k1 = self
+            .directions
+            .iter()
+            .position(|d| d.azimuth_deg > az)
+            .unwrap_or(0);
+        let k0 = (k1 + n - 1) % n;
+        let (a0, a1) = (
+            self.directions[k0].azimuth_deg,
+            self.directions[k1].azimuth_deg,
+        );
+        let span = (a1 - a0).rem_euclid(360.0);
+        let w = if span == 0.0 {
+            0.0
+        } else {
+            (az - a0).rem_euclid(360.0) / span
+        };
+        (k0, k1, w)
+    }
+
+    /// Hard shadows for any sun in O(1) per pixel: shadowed when the elevation is below the
+    /// horizon interpolated between the two stored azimuths around the sun's.
+    pub fn shadow_mask(&self, sun: &super::sun::Sun) -> Vec<bool> {
+        let n = self.width * self.height;
+        if sun.elevation_deg >= 90.0 {
+            return vec![false; n];
+        }
+        if sun.elevation_deg <= 0.0 {
+            return vec![true; n];
+        }
+        let (k0, k1, w) = self.bracket(sun.azimuth_deg);
+        let (p0, p1) = (&self.angles[k0], &self.angles[k1]);
+        (0..n)
+            .into_par_iter()
+            .map(|i| sun.elevation_deg < horizon_at(p0[i], p1[i], w))
+            .collect()
+    }
+
+    /// Planes `k0` and `k1` packed per texel as the GPU reads them (`horizon_pair` of
+    /// `shaders/terrain_shadow.wgsl`): `k0`'s value in the low 16 bits, `k1`'s in the high.
+    pub fn packed_pair(&self, k0: usize, k1: usize) -> Vec<u32> {
+        self.angles[k0]
+            .par_iter()
+            .zip(&self.angles[k1])
+            .map(|(&a, &b)| a as u32 | (b as u32) << 16)
+            .collect()
+    }
+
+    /// The GPU's horizon mask (`shadowed_horizon` in `shaders/terrain_shadow.wgsl`), its f32
+    /// twin: the bracket and weight in f64 as the renderer computes them, the test in f32.
+    pub fn shadow_mask_f32(&self, sun: &super::sun::Sun) -> Vec<bool> {
+        let n = self.width * self.height;
+        let track = super::sun::Track::new(sun, [1.0, 1.0]);
+        match track.kind {
+            super::sun::TrackKind::Zenith => return vec![false; n],
+            super::sun::TrackKind::BelowHorizon => return vec![true; n],
+            super::sun::TrackKind::Ray => {}
+        }
+        let (k0, k1, w) = self.bracket(sun.azimuth_deg);
+        let (p0, p1) = (&self.angles[k0], &self.angles[k1]);
+        let e = sun.elevation_deg as f32;
+        (0..n)
+            .into_par_iter()
+            .map(|i| shadowed_f32(p0[i], p1[i], w as f32, e))
+            .collect()
+    }
+
+    /// The sky-view factor of a horizontal surface: the part of the sky hemisphere's
+    /// projected area above the horizon, Σ_k w_k (1 − sin max(H_k, 0)), each direction weighted
+    /// by half the azimuth gap to its neighbours (1 on flat ground; 1 − sin H under a uniform
+    /// horizon H).
+    pub fn sky_view(&self) -> Vec<f32> {
+        let n = self.directions.len();
+        let weights: Vec<f64> = (0..n)
+            .map(|k| {
+                let prev = self.directions[(k + n - 1) % n].azimuth_deg;
+                let next = self.directions[(k + 1) % n].azimuth_deg;
+                let gap = (next - prev).rem_euclid(360.0);
+                let gap = if n == 1 { 720.0 } else { gap };
+                0.5 * gap / 360.0
+            })
+            .collect();
+        (0..self.width * self.height)
+            .into_par_iter()
+            .map(|i| {
+                let mut v = 0.0;
+                for (k, w) in weights.iter().enumerate() {
+                    v += w * (1.0 - decode(self.angles[k][i]).max(0.0).to_radians().sin());
+                }
+                v as f32
+            })
+            .collect()
+    }
+}
