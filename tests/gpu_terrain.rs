@@ -266,3 +266,150 @@ fn player_renders_a_height_map_bake_headless() {
         "soft shadows look exactly like hard ones"
     );
 }
+
+/// The horizon-map mask on the GPU (`shadowed_horizon`) against its f32 twin
+/// (`HorizonMap::shadow_mask_f32`) and the f64 test (`HorizonMap::shadow_mask`); at a stored
+/// azimuth, against the exact traversal. Returns nothing; asserts.
+#[test]
+fn gpu_horizon_masks_match_the_twin_and_the_exact_mask() {
+    use relume::terrain::horizon_map::{decode, HorizonMap, HorizonSettings};
+    let Some(gpu) = gpu() else { return };
+    let map = srtm_half();
+    let mip = MinMaxMipmap::build(&map);
+    let hm = HorizonMap::build(
+        &map,
+        &HorizonSettings {
+            directions: 32,
+            planet_radius: None,
+        },
+    );
+    let mut r = TerrainRenderer::new(&gpu, &map, &mip, 8, 8, None).unwrap();
+    // Before horizon maps are set, method 3 falls back to the accelerated traversal.
+    let sun0 = Sun::new(123.0, 7.0).unwrap();
+    r.set_sun(&gpu, sun0);
+    assert_eq!(
+        r.shadow_mask_horizon(&gpu).unwrap(),
+        r.shadow_mask(&gpu, true).unwrap()
+    );
+    r.set_horizon(&gpu, hm.clone()).unwrap();
+    let stored = hm.directions[5].azimuth_deg;
+    let mut all = suns();
+    all.extend([
+        Sun::new(stored, 12.0).unwrap(),
+        Sun::new(stored + 1.3, 12.0).unwrap(),
+        Sun::new(10.0, 90.0).unwrap(),
+        Sun::new(10.0, -1.0).unwrap(),
+        Sun::new(10.0, 0.0).unwrap(),
+    ]);
+    let (mut total, mut off_twin, mut off_f64) = (0usize, 0usize, 0usize);
+    for sun in &all {
+        r.set_sun(&gpu, *sun);
+        let g = r.shadow_mask_horizon(&gpu).unwrap();
+        let twin = hm.shadow_mask_f32(sun);
+        let f64_mask = hm.shadow_mask(sun);
+        let (k0, k1, w) = hm.bracket(sun.azimuth_deg);
+        for i in 0..g.len() {
+            if g[i] != twin[i] {
+                // Only a fused multiply-add on the GPU can move the test, and only for an
+                // elevation within f32 rounding of the interpolated horizon.
+                let h = decode(hm.angles[k0][i]) * (1.0 - w) + decode(hm.angles[k1][i]) * w;
+                assert!(
+                    (h - sun.elevation_deg).abs() < 1e-4,
+                    "sun {sun:?} texel {i}: GPU {} twin {} (horizon {h}°)",
+                    g[i],
+                    twin[i]
+                );
+                off_twin += 1;
+            }
+        }
+        off_f64 += g.iter().zip(&f64_mask).filter(|(a, b)| a != b).count();
+        total += g.len();
+    }
+    eprintln!(
+        "horizon masks: GPU vs f32 twin {off_twin}, vs f64 {off_f64} of {total} texel-sun cases"
+    );
+    assert!(off_twin * 10_000 <= total, "{off_twin} of {total}");
+    // At a stored azimuth the interpolation weight is 0 or 1: the horizon map is the exact
+    // traversal's shadow test for every elevation, up to the u16 quantisation (≤ 0.0014°).
+    let sun = Sun::new(stored, 12.0).unwrap();
+    r.set_sun(&gpu, sun);
+    let g = r.shadow_mask_horizon(&gpu).unwrap();
+    let exact = shadow_mask(
+        &map,
+        &sun,
+        HardMethod::Exact,
+        None,
+        &relume::progress::Silent,
+    );
+    let off = g.iter().zip(&exact).filter(|(a, b)| a != b).count();
+    eprintln!(
+        "horizon mask at stored azimuth {stored:.4}°/12°: {off} of {} pixels differ from the exact mask",
+        g.len()
+    );
+    // Measured on lavapipe: see docs/terrain.md; each such pixel has its horizon within the
+    // quantisation step of 12°.
+    let (k0, k1, w) = hm.bracket(stored);
+    let k = if w < 0.5 { k0 } else { k1 };
+    for i in 0..g.len() {
+        if g[i] != exact[i] {
+            let h = decode(hm.angles[k][i]);
+            assert!(
+                (h - 12.0).abs() <= relume::terrain::horizon_map::STEP_DEG,
+                "texel {i}: horizon {h}° vs sun 12°"
+            );
+        }
+    }
+}
+
+#[test]
+fn map_view_with_horizon_shadows_matches_the_cpu_shading() {
+    use relume::terrain::horizon_map::{HorizonMap, HorizonSettings};
+    let Some(gpu) = gpu() else { return };
+    let map = srtm_half();
+    let mip = MinMaxMipmap::build(&map);
+    let (w, h) = (map.width as u32, map.height as u32);
+    let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
+    let hm = HorizonMap::build(
+        &map,
+        &HorizonSettings {
+            directions: 16,
+            planet_radius: None,
+        },
+    );
+    r.set_horizon(&gpu, hm.clone()).unwrap();
+    let sun = Sun::new(205.0, 9.0).unwrap();
+    r.set_sun(&gpu, sun);
+    let s = TerrainSettings {
+        fog: false,
+        vertical_exaggeration: 1.0,
+        ..Default::default()
+    };
+    assert!(
+        s.horizon,
+        "horizon shadows are the default when a bake has them"
+    );
+    let (view_proj, eye) = r.map_view();
+    let mut timer = PassTimer::new(&gpu, 2);
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    r.record(&gpu, &mut enc, view_proj, eye, &s, &mut timer);
+    gpu.queue.submit([enc.finish()]);
+    let img = r.target.read_image(&gpu).unwrap();
+    let shadow: Vec<f32> = hm
+        .shadow_mask_f32(&sun)
+        .iter()
+        .map(|&b| b as u8 as f32)
+        .collect();
+    let want = map_view(&map, &sun, &shadow, &s);
+    let mut worst = 0u8;
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let (a, b) = (img.get_pixel(x, y), want.get_pixel(x, y));
+            for c in 0..3 {
+                worst = worst.max(a[c].abs_diff(b[c]));
+            }
+        }
+    }
+    eprintln!("terrain map view with horizon shadows: max |GPU − CPU| = {worst}/255");
+    // As in the traversal's map view: one 8-bit step at rounding boundaries.
+    assert!(worst <= 1, "max difference {worst}/255");
+}
