@@ -9,7 +9,8 @@
 
 use relume::bake::{run_pipeline, BakeOptions};
 use relume::gpu::Gpu;
-use relume::pipeline::parse_pipeline;
+use relume::pipeline::knobs::HorizonMapsKnobs;
+use relume::pipeline::{parse_pipeline, Stage};
 use relume::player::headless::{render_frames, HeadlessPlan};
 use relume::player::{PlayerOptions, Sun};
 use relume::render::mesh_reference::FrameSettings;
@@ -19,6 +20,17 @@ use std::path::Path;
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());
     v[v.len() / 2]
+}
+
+/// The shadows of a row.
+#[derive(Clone, Copy, PartialEq)]
+enum Shadows {
+    None,
+    /// Shadow maps (mesh) or the accelerated traversal (terrain).
+    Hard,
+    /// Terrain: the baked horizon maps.
+    Horizon,
+    Soft,
 }
 
 fn main() {
@@ -48,26 +60,35 @@ fn main() {
         (
             "pipelines/cornell.ron",
             vec![
-                ("emitter + sun, shadows", Some(false)),
-                ("emitter + sun, no shadows", None),
+                ("emitter + sun, shadows", Shadows::Hard),
+                ("emitter + sun, no shadows", Shadows::None),
             ],
         ),
         (
             "pipelines/puget-sound-2k.ron",
             vec![
-                ("no shadows", None),
-                ("hard shadows", Some(false)),
-                ("soft shadows", Some(true)),
+                ("no shadows", Shadows::None),
+                ("hard shadows (traversal)", Shadows::Hard),
+                ("hard shadows (horizon maps, 64)", Shadows::Horizon),
+                ("soft shadows", Shadows::Soft),
             ],
         ),
     ] {
-        let p = parse_pipeline(&root.join(pipeline)).expect("pipeline");
+        let mut p = parse_pipeline(&root.join(pipeline)).expect("pipeline");
+        if p.input.kind() == "heightmap"
+            && !p.stages.iter().any(|s| matches!(s, Stage::HorizonMaps(_)))
+        {
+            // The player's horizon-map shadows need them baked (64 directions, 512 MiB at 2K).
+            p.stages
+                .push(Stage::HorizonMaps(HorizonMapsKnobs::default()));
+        }
         let dir = tmp.join(Path::new(pipeline).file_stem().unwrap());
         run_pipeline(&p, &dir, &BakeOptions::default(), &relume::progress::Silent).expect("bake");
         for (w, h) in [(640u32, 480u32), (1920, 1080)] {
-            for (label, soft) in &configs {
-                // None: no shadows; Some(soft): hard or soft shadows. The headless loop of
-                // relume-player itself; frame 0 is the warm-up.
+            for (label, shadows) in &configs {
+                // The headless loop of relume-player itself; frame 0 is the warm-up. The sun
+                // turns 360°/frames per frame, so horizon maps upload a new pair of planes
+                // every frame (their worst case).
                 let plan = HeadlessPlan {
                     dir: dir.clone(),
                     out: tmp.join("frames"),
@@ -80,8 +101,9 @@ fn main() {
                     lights: Vec::new(),
                     camera: None,
                     settings: FrameSettings {
-                        shadows: soft.is_some(),
-                        soft_shadows: soft.unwrap_or(false),
+                        shadows: *shadows != Shadows::None,
+                        soft_shadows: *shadows == Shadows::Soft,
+                        horizon_shadows: *shadows == Shadows::Horizon,
                         exposure: 2.0,
                         ..Default::default()
                     },

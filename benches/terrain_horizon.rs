@@ -118,4 +118,31 @@ fn main() {
             100.0 * differ as f64 / exact.len() as f64
         );
     }
+    // Sunlight over a day from the same map (issue 14 item 4: "a day at 10-minute steps costs
+    // little more than one horizon pass"): Seattle's summer solstice, hours only and with the
+    // clear-sky insolation.
+    let date = relume::terrain::solar::Instant::parse("2026-06-21T00:00:00Z").unwrap();
+    let place = relume::terrain::solar::Place::new(47.6, -122.3, 0.0).unwrap();
+    let steps = relume::terrain::sunlight::day_steps(&date, &place, 600.0, 0.0).unwrap();
+    println!(
+        "\n### Sunlight over a day from the map ({} steps of 10 minutes)\n",
+        steps.len()
+    );
+    println!("| output | time |");
+    println!("|---|---|");
+    for insolation in [false, true] {
+        let t = Instant::now();
+        let (hours, _) = relume::terrain::sunlight::sunlight(&map, &hm, &steps, insolation);
+        let secs = t.elapsed().as_secs_f64();
+        assert_eq!(hours.len(), map.width * map.height);
+        println!(
+            "| {} | {:.2} s |",
+            if insolation {
+                "hours + insolation"
+            } else {
+                "hours"
+            },
+            secs
+        );
+    }
 }

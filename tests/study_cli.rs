@@ -326,6 +326,41 @@ fn terrain_quick_accelerated_and_sweep_equal_exact_and_report_is_thread_independ
     }
 }
 
+#[test]
+fn terrain_dp_rows_sweep_start_levels_and_interval_caps() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = study(
+        dir.path(),
+        &["terrain", "--dp-levels", "1", "--dp-intervals", "0,1,3"],
+    );
+    let soft = sweep(&j, "terrain_soft_shadows");
+    for size in ["256x256", "512x512"] {
+        let mean = |label: &str| {
+            err(
+                setting(
+                    soft,
+                    &format!("{size} 5° dynamic programming, start level 1{label}"),
+                ),
+                "lit_fraction",
+                "mean",
+            )
+        };
+        let (one, three, all) = (mean(", 1 intervals"), mean(", 3 intervals"), mean(""));
+        // A capped run looks at a prefix of the uncapped run's intervals, and dynamic
+        // programming is never darker than the exhaustive walk: fewer intervals, lighter
+        // pixels, a larger mean error.
+        assert!(one >= three && three >= all, "{size}: {one} {three} {all}");
+        assert!(
+            one > all,
+            "{size}: the cap changes nothing ({one} vs {all})"
+        );
+        assert!(
+            !labels(soft).iter().any(|l| l.contains("start level 4")),
+            "--dp-levels replaces the default levels"
+        );
+    }
+}
+
 /// The report without measured times (and numbers derived from them) and the thread count.
 fn strip_times(mut j: Value) -> Value {
     j["threads"] = Value::Null;

@@ -226,7 +226,7 @@ fn a_tower_beyond_the_curve_of_the_earth() {
         (3000e3, (-25.0 / (2.0 * 3000e3f64)).atan()),
     ] {
         let sweep = horizon_sweep(&map, &east, Some(radius));
-        let got = sweep[w + 0] as f64;
+        let got = sweep[w] as f64;
         assert!(
             (got - want.to_degrees()).abs() < 1e-6,
             "R {radius}: {got}° vs {}°",

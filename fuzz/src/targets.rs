@@ -153,7 +153,7 @@ fn freeform(path: &Path, text: &str) {
 }
 
 /// The player's readers of a baked directory: patches, scene, transfer info, sidecar, the
-/// `.npy` matrices, the permutation, the mipmap EXR, and the DDS / KTX2 texture parsers for
+/// `.npy` matrices (and the horizon maps' u16 / i32 arrays), the permutation, the mipmap EXR, and the DDS / KTX2 texture parsers for
 /// every encoding.
 pub fn baked(data: &[u8]) {
     use relume::baked;
@@ -182,10 +182,15 @@ pub fn baked(data: &[u8]) {
             baked::encoded::SIDECAR_FILE,
             rest,
         ))),
-        4 => drop(baked::transport::read_file(&file(
-            baked::transport::FILE,
-            rest,
-        ))),
+        4 => {
+            drop(baked::transport::read_file(&file(
+                baked::transport::FILE,
+                rest,
+            )));
+            // The same header parser for the horizon maps' u16 planes and i32 directions.
+            drop(baked::npy::parse_npy::<u16>(rest));
+            drop(baked::npy::parse_npy::<i32>(rest));
+        }
         5 => drop(baked::form_factors::read_file(&file(
             baked::form_factors::FILE,
             rest,

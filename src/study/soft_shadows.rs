@@ -31,7 +31,7 @@ impl SoftConfig {
         SoftConfig {
             elevations: vec![2.0, 5.0, 10.0],
             rows: 128,
-            methods: methods(&[32, 100, 256], &[0, 1, 2, 3, 4, 8]),
+            methods: methods(&[32, 100, 256], &[0, 1, 2, 3, 4, 8], &[0]),
         }
     }
 
@@ -39,25 +39,63 @@ impl SoftConfig {
         SoftConfig {
             elevations: vec![5.0],
             rows: 32,
-            methods: methods(&[32, 100], &[0, 4]),
+            methods: methods(&[32, 100], &[0, 4], &[0]),
         }
     }
 }
 
-/// Uniform stepping at `steps`, dynamic programming from `levels`, and branch-and-bound.
-fn methods(steps: &[u32], levels: &[i32]) -> Vec<SoftMethod> {
+impl SoftConfig {
+    /// Replace the dynamic-programming rows by every start level of `levels` with every
+    /// interval cap of `intervals` (0 = as many as the track needs).
+    pub fn set_dp(&mut self, levels: &[i32], intervals: &[u32]) {
+        self.methods
+            .retain(|m| !matches!(m, SoftMethod::DynamicProgramming { .. }));
+        let bnb = self.methods.pop();
+        self.methods.extend(dp(levels, intervals));
+        self.methods.extend(bnb);
+    }
+
+    /// The start levels and interval caps of the dynamic-programming rows.
+    pub fn dp_knobs(&self) -> (Vec<i32>, Vec<u32>) {
+        let (mut levels, mut intervals) = (Vec::new(), Vec::new());
+        for m in &self.methods {
+            if let SoftMethod::DynamicProgramming {
+                start_level,
+                intervals: k,
+            } = *m
+            {
+                if !levels.contains(&start_level) {
+                    levels.push(start_level);
+                }
+                if !intervals.contains(&k) {
+                    intervals.push(k);
+                }
+            }
+        }
+        (levels, intervals)
+    }
+}
+
+/// Dynamic programming from every start level with every interval cap.
+fn dp<'a>(levels: &'a [i32], intervals: &'a [u32]) -> impl Iterator<Item = SoftMethod> + 'a {
+    levels.iter().flat_map(move |&start_level| {
+        intervals
+            .iter()
+            .map(move |&intervals| SoftMethod::DynamicProgramming {
+                start_level,
+                intervals,
+            })
+    })
+}
+
+/// Uniform stepping at `steps`, dynamic programming from `levels` with each interval cap of
+/// `intervals`, and branch-and-bound.
+fn methods(steps: &[u32], levels: &[i32], intervals: &[u32]) -> Vec<SoftMethod> {
     let mut m: Vec<SoftMethod> = steps
         .iter()
         .map(|&steps| SoftMethod::Uniform { steps })
         .collect();
-    m.extend(
-        levels
-            .iter()
-            .map(|&start_level| SoftMethod::DynamicProgramming {
-                start_level,
-                intervals: 0,
-            }),
-    );
+    m.extend(dp(levels, intervals));
     m.push(SoftMethod::BranchAndBound);
     m
 }

@@ -113,6 +113,13 @@ pub struct TerrainArgs {
     /// is slow at low sun)
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65_536))]
     pub soft_rows: Option<u32>,
+    /// Start levels of the dynamic-programming rows, e.g. 0,1,4 (default 0,1,2,3,4,8)
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = clap::value_parser!(i32).range(-1..=30), allow_hyphen_values = true)]
+    pub dp_levels: Option<Vec<i32>>,
+    /// Interval caps of the dynamic-programming rows, each with every start level, e.g.
+    /// 0,4,16 (0 = as many as the track needs; default 0)
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub dp_intervals: Option<Vec<u32>>,
 }
 
 fn finite(s: &str) -> std::result::Result<f64, String> {
@@ -207,6 +214,13 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
             }
             if let Some(r) = a.soft_rows {
                 cfg.soft.rows = r as usize;
+            }
+            if a.dp_levels.is_some() || a.dp_intervals.is_some() {
+                let (levels, intervals) = cfg.soft.dp_knobs();
+                cfg.soft.set_dp(
+                    a.dp_levels.as_deref().unwrap_or(&levels),
+                    a.dp_intervals.as_deref().unwrap_or(&intervals),
+                );
             }
             Study::new("terrain", name, quick, terrain::run(&map, &cfg, ui)?)
         }
