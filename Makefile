@@ -11,7 +11,7 @@ export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
 
-.PHONY: all build demo docs-images test deps deps-apt deps-py fuzz fmt lint bench bench-grass study ci clean
+.PHONY: all build demo docs-images test deps deps-apt deps-py deps-npm fuzz fmt lint bench bench-grass study ci clean
 
 all: build
 
@@ -121,7 +121,7 @@ test: deps
 bench-grass:
 	scripts/grass/sunmask_compare.sh
 
-deps: deps-apt deps-py
+deps: deps-apt deps-py deps-npm
 
 deps-apt:
 	@missing=""; for p in $(APT_PKGS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
@@ -138,6 +138,16 @@ deps-py:
 	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) && \
 	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio"; } || \
 	  { echo "error: cannot install the Python cross-check readers ($(PY_PKGS))" >&2; exit 1; }
+
+## The Khronos glTF-Validator for the glTF export's test (Node and npm; pinned in tools/npm).
+deps-npm:
+	@test -d tools/npm/node_modules/gltf-validator || { \
+	  command -v npm >/dev/null 2>&1 || { command -v apt-get >/dev/null 2>&1 && \
+	    $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	    $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends nodejs npm; } || \
+	    { echo "error: npm is needed for the glTF-Validator (apt-get install nodejs npm)" >&2; exit 1; }; \
+	  cd tools/npm && npm ci --no-audit --no-fund --loglevel=error; } || \
+	  { echo "error: cannot install the glTF-Validator (tools/npm)" >&2; exit 1; }
 
 ## Coverage-guided fuzzing of every reader with AFL++ on stable Rust (docs/fuzzing.md): EXECS
 ## executions per target (default 10 M; hours on 2 cores), crashes in $(FUZZ_OUT)/<target>/.

@@ -8,9 +8,14 @@ use std::path::Path;
 /// What `relume-bake export` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ExportWhat {
+    /// The patches as JSON.
     Patches,
+    /// `form_factors.npy`.
     FormFactors,
+    /// `transport.npy`.
     Transport,
+    /// The scene with its baked lighting for a light setup, binary glTF ([`super::gltf`]).
+    Gltf,
 }
 
 /// A standard light configuration of the encode report (`compress::report::standard_lights`).
@@ -50,6 +55,10 @@ pub fn export(dir: &Path, what: ExportWhat, out: &Path) -> Result<&'static str> 
         ExportWhat::Patches => super::patches::FILE,
         ExportWhat::FormFactors => super::form_factors::FILE,
         ExportWhat::Transport => super::transport::FILE,
+        ExportWhat::Gltf => {
+            super::gltf::export_lit_glb(dir, &Default::default(), out)?;
+            return Ok("gltf");
+        }
     };
     if manifest.file(file).is_none() {
         return Err(Error::input(
@@ -91,6 +100,7 @@ pub fn export(dir: &Path, what: ExportWhat, out: &Path) -> Result<&'static str> 
                 .map_err(|e| Error::Internal(format!("cannot encode JSON: {e}")))?;
             std::fs::write(out, text).map_err(|e| Error::io(out, "cannot write", e))?;
         }
+        ExportWhat::Gltf => unreachable!("exported above"),
         ExportWhat::FormFactors | ExportWhat::Transport => {
             let (shape, values) = super::npy::read_npy_f32(&src)?;
             super::npy::write_npy_f32(out, &shape, &values)?;

@@ -12,6 +12,7 @@ pub mod encoded;
 pub mod export;
 pub mod exr_io;
 pub mod form_factors;
+pub mod gltf;
 pub mod heightmap;
 pub mod horizon;
 pub mod images;

@@ -14,7 +14,7 @@ use crate::radiosity::PatchSet;
 use crate::render::camera::Camera;
 use crate::render::lights::GpuLight;
 use crate::render::mesh_reference::FrameSettings;
-use crate::scene::{Light, LightKind, Scene};
+use crate::scene::{Light, Scene};
 use std::path::Path;
 
 /// A loaded mesh bake.
@@ -71,18 +71,7 @@ impl MeshPlayer {
     /// Set or clear the sun (a white directional light of 3 W/m² irradiance... scaled by the
     /// scene's size-independent units: irradiance is per square metre of scene unit).
     pub fn set_sun(&mut self, gpu: &Gpu, sun: Option<Sun>) -> Result<()> {
-        self.sun = sun.map(|s| {
-            let l = Light {
-                name: "sun".into(),
-                kind: LightKind::Directional,
-                position: [0.0; 3],
-                direction: (-s.toward_y_up()).to_array(),
-                color: [1.0, 0.97, 0.92],
-                intensity: 3.0,
-                range: None,
-            };
-            GpuLight::from_light(&l, 1.0, 0)
-        });
+        self.sun = sun.map(|s| GpuLight::from_light(&crate::render::lights::sun_light(&s), 1.0, 0));
         self.upload_lights(gpu)
     }
 

@@ -4,7 +4,22 @@
 
 use super::camera::{look_at, orthographic, perspective};
 use crate::scene::{Light, LightKind};
+use crate::terrain::sun::Sun;
 use glam::{Mat4, Vec3};
+
+/// The sun of a mesh scene: a white directional light of 3 W/m² toward `sun` (y up), what
+/// the player's `--sun` adds and `relume-bake export DIR gltf --sun` bakes.
+pub fn sun_light(sun: &Sun) -> Light {
+    Light {
+        name: "sun".into(),
+        kind: LightKind::Directional,
+        position: [0.0; 3],
+        direction: (-sun.toward_y_up()).to_array(),
+        color: [1.0, 0.97, 0.92],
+        intensity: 3.0,
+        range: None,
+    }
+}
 
 /// Most punctual lights per frame.
 pub const MAX_LIGHTS: usize = 8;

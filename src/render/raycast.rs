@@ -53,6 +53,25 @@ impl RaycastScene {
         RaycastScene { verts, vis, extent }
     }
 
+    /// Whether light `l` of `lights` reaches point `p` (normal `n`, unit vector `to_light`,
+    /// distance `dist`): a shadow ray through the BVH from `p` lifted by the BVH's epsilon along
+    /// `n` (the closure [`shade_point`] and [`super::direct::patch_exitance`] take).
+    pub fn visible<'a>(
+        &'a self,
+        lights: &'a [GpuLight],
+    ) -> impl Fn(usize, Vec3, Vec3, Vec3, f32) -> bool + Sync + 'a {
+        let far = 4.0 * self.extent;
+        let eps = self.vis.epsilon;
+        move |l: usize, p: Vec3, n: Vec3, to_light: Vec3, dist: f32| {
+            let end = if lights[l].kind() == KIND_DIRECTIONAL {
+                p + to_light * far
+            } else {
+                p + to_light * dist
+            };
+            !self.vis.occluded((p + n * eps).as_dvec3(), end.as_dvec3())
+        }
+    }
+
     /// Render `width`×`height` RGBA8 with per-corner indirect exitance `indirect` (3 floats per
     /// corner, or empty for none).
     pub fn render(
@@ -65,18 +84,7 @@ impl RaycastScene {
         height: u32,
     ) -> image::RgbaImage {
         let bg = s.background.map(to_u8);
-        let far = 4.0 * self.extent;
-        let eps = self.vis.epsilon;
-        let visible = |l: usize, p: Vec3, n: Vec3, to_light: Vec3, dist: f32| {
-            let light = &lights[l];
-            let end = if light.kind() == KIND_DIRECTIONAL {
-                p + to_light * far
-            } else {
-                p + to_light * dist
-            };
-            // Shadow rays leave the surface lifted by the BVH's epsilon along the normal.
-            !self.vis.occluded((p + n * eps).as_dvec3(), end.as_dvec3())
-        };
+        let visible = self.visible(lights);
         let rows: Vec<Vec<u8>> = (0..height)
             .into_par_iter()
             .map(|y| {

@@ -4,13 +4,19 @@
 use clap::{Args, Subcommand};
 use relume::bake::{run_stage_on_with, BakeOptions};
 use relume::baked::export::ExportWhat;
+use relume::baked::gltf::{export_lit_glb, LitExport};
 use relume::error::exit;
 use relume::pipeline::checks::arg;
 use relume::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
 use relume::pipeline::Stage;
+use relume::player::headless::args;
+use relume::player::light_spec::parse_light;
+use relume::player::Sun;
 use relume::radiosity::formfactor::Estimator;
 use relume::radiosity::transport::{Bounces, Power};
 use relume::radiosity::voxelize::Resolution;
+use relume::render::mesh_reference::FrameSettings;
+use relume::scene::Light;
 use relume::Result;
 use std::path::PathBuf;
 
@@ -62,17 +68,71 @@ pub enum Command {
         #[command(flatten)]
         budget: Budget,
     },
-    /// Export patches as JSON, or the form-factor / transport matrix as .npy
+    /// Export patches as JSON, the form-factor / transport matrix as .npy, or the scene with
+    /// its baked light as binary glTF (gltf: per-vertex radiance for the scene's lights and
+    /// emitters plus --light / --sun)
     Export {
         /// Baked directory
         baked_dir: PathBuf,
         /// What to export
         #[arg(value_enum)]
         what: ExportWhat,
-        /// Output file
+        /// Output file (.json, .npy, or .glb for gltf)
         #[arg(long, short)]
         out: PathBuf,
+        #[command(flatten)]
+        lit: LitArgs,
     },
+}
+
+/// The light setup of `export gltf` (the player's flags).
+#[derive(Args)]
+pub struct LitArgs {
+    /// gltf: add a punctual light (repeatable), as the player's --light:
+    /// point:X,Y,Z[:I[:R,G,B]], spot:X,Y,Z:DX,DY,DZ:ANGLE[:I[:R,G,B]], dir:DX,DY,DZ[:I[:R,G,B]]
+    #[arg(long, value_name = "SPEC", value_parser = parse_light, allow_hyphen_values = true)]
+    light: Vec<Light>,
+    /// gltf: add the sun at azimuth,elevation in degrees, as the player's --sun (e.g. 20,30)
+    #[arg(long, value_name = "AZ,EL", value_parser = args::sun, allow_hyphen_values = true)]
+    sun: Option<Sun>,
+    /// gltf: multiply radiance by this before clamping into COLOR_0 [default: 1]
+    #[arg(long, value_name = "X", value_parser = arg::positive_f32)]
+    exposure: Option<f32>,
+    /// gltf: split triangles longer than this (scene units) into a grid, so that direct light
+    /// and shadows vary across them [default: 1/32 of the scene's diagonal]
+    #[arg(long, value_name = "L", value_parser = arg::positive_f32)]
+    max_edge: Option<f32>,
+    /// gltf: no shadows for the punctual lights and the sun
+    #[arg(long)]
+    no_shadows: bool,
+    /// gltf: leave out the baked indirect light (direct light and emission only)
+    #[arg(long)]
+    no_indirect: bool,
+}
+
+impl LitArgs {
+    fn given(&self) -> bool {
+        !self.light.is_empty()
+            || self.sun.is_some()
+            || self.exposure.is_some()
+            || self.max_edge.is_some()
+            || self.no_shadows
+            || self.no_indirect
+    }
+
+    fn setup(&self) -> LitExport {
+        LitExport {
+            lights: self.light.clone(),
+            sun: self.sun,
+            max_edge: self.max_edge,
+            settings: FrameSettings {
+                exposure: self.exposure.unwrap_or(1.0),
+                shadows: !self.no_shadows,
+                indirect: !self.no_indirect,
+                ..Default::default()
+            },
+        }
+    }
 }
 
 #[derive(Args)]
@@ -136,7 +196,30 @@ pub fn run(cmd: &Command, json: bool, quiet: bool, ui: &crate::ui::Ui) -> Result
             baked_dir,
             what,
             out,
+            lit,
         } => {
+            if *what == ExportWhat::Gltf {
+                let report = export_lit_glb(baked_dir, &lit.setup(), out)?;
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&report).expect("report"));
+                } else if !quiet {
+                    eprintln!(
+                        "wrote {}: {} objects, {} triangles, {} lights, transport {} ({} bytes)",
+                        report.out,
+                        report.objects,
+                        report.triangles,
+                        report.lights,
+                        report.transport,
+                        report.bytes
+                    );
+                }
+                return Ok(exit::OK);
+            }
+            if lit.given() {
+                return Err(relume::error::Error::knob(
+                    "--light, --sun, --exposure, --max-edge, --no-shadows and --no-indirect apply to `export gltf` only",
+                ));
+            }
             let file = relume::baked::export::export(baked_dir, *what, out)?;
             if json {
                 println!("{}", serde_json::json!({"exported": file, "out": out}));

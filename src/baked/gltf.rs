@@ -1,0 +1,346 @@
+//! `relume-bake export DIR gltf`: the scene of a radiosity bake with its baked lighting for one
+//! light setup, as a binary glTF 2.0 file that other tools open (Blender, three.js, any
+//! glTF viewer), validated by the Khronos glTF-Validator in the tests.
+//!
+//! The lighting is what the player shows, evaluated on the CPU at every triangle corner:
+//! direct exitance per patch (the lights' irradiance at the patch's sample points, shadow rays
+//! through the BVH) → indirect light `B = S·E` from the bake's transport (the dense
+//! `transport.npy` when present, else the encoded one) → per-corner interpolation → outgoing
+//! radiance at the corner ([`crate::render::mesh_reference::shade_point`]: direct + indirect +
+//! emission), at every vertex of a regular split of each triangle whose longest edge is over
+//! `max_edge` (the indirect light interpolated from the triangle's corners, as the player does
+//! per pixel; direct light and shadows evaluated at the vertex). The file holds, per object of
+//! the scene, one indexed mesh (vertices are not shared between scene triangles, whose corners
+//! carry their own light) with
+//!
+//! - `POSITION` (the scene's units), `NORMAL` (the face normal),
+//! - `COLOR_0`: linear RGB radiance × `exposure`, clamped to [0, 1] (glTF's colour range), shown
+//!   as is by an unlit material (`KHR_materials_unlit`, base colour 1),
+//! - `_RADIANCE`: the unclamped linear radiance (W·sr⁻¹·m⁻² of the scene's units), for tools
+//!   that tone-map themselves.
+//!
+//! Degenerate triangles are left out. Written atomically.
+
+use crate::error::{Error, Result};
+use crate::render::direct::{corner_indirect, gather_dense, patch_exitance};
+use crate::render::lights::{sun_light, GpuLight};
+use crate::render::mesh_reference::{corner_vertices, shade_point, FrameSettings};
+use crate::render::raycast::RaycastScene;
+use crate::scene::{Light, Scene};
+use crate::terrain::sun::Sun;
+use glam::Vec3;
+use serde::Serialize;
+use serde_json::{json, Value};
+use std::path::Path;
+
+/// The light setup of an export.
+#[derive(Clone, Debug, Default)]
+pub struct LitExport {
+    /// Punctual lights added to the scene's own.
+    pub lights: Vec<Light>,
+    /// A sun (the player's `--sun`).
+    pub sun: Option<Sun>,
+    /// Direct, indirect, shadows, emission, exposure and emission scale.
+    pub settings: FrameSettings,
+    /// Longest triangle edge in the file (scene units): longer triangles are split into a
+    /// regular grid of sub-triangles so that direct light and shadows vary across them as in
+    /// the player (which shades per pixel); None: 1/32 of the scene's diagonal.
+    pub max_edge: Option<f32>,
+}
+
+/// Most sub-triangles along an edge when splitting by [`LitExport::max_edge`].
+pub const MAX_SPLIT: usize = 64;
+
+/// What an export wrote.
+#[derive(Clone, Debug, Serialize)]
+pub struct LitReport {
+    pub out: String,
+    pub bytes: u64,
+    pub objects: usize,
+    /// Triangles of the scene exported, and triangles and vertices in the file (after
+    /// splitting by `max_edge`).
+    pub scene_triangles: usize,
+    pub triangles: usize,
+    pub vertices: usize,
+    pub degenerate_triangles_left_out: usize,
+    pub lights: usize,
+    pub transport: &'static str,
+    /// Largest radiance of any vertex channel, and the fraction of vertex channels clamped in
+    /// `COLOR_0`.
+    pub max_radiance: f32,
+    pub clamped_fraction: f64,
+}
+
+/// Export the bake in `dir` lit by `setup` to `out` (`.glb`).
+pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitReport> {
+    let manifest = super::Manifest::read(dir)?;
+    for need in [super::scene::FILE, super::patches::FILE] {
+        if manifest.file(need).is_none() {
+            return Err(Error::input(
+                dir,
+                format!("this bake has no `{need}`: glTF export needs a scene bake with `Voxelize` (see `relume-bake inspect`)"),
+            ));
+        }
+    }
+    let scene = super::scene::read(dir)?;
+    let set = super::patches::read(dir)?;
+    let mut lights: Vec<Light> = scene.lights.clone();
+    lights.extend(setup.lights.iter().cloned());
+    lights.extend(setup.sun.as_ref().map(sun_light));
+    let gpu_lights: Vec<GpuLight> = lights
+        .iter()
+        .map(|l| GpuLight::from_light(l, 1.0, 0))
+        .collect();
+    let s = &setup.settings;
+    let rs = RaycastScene::new(&scene);
+    let e = patch_exitance(&set, &gpu_lights, s, &rs.visible(&gpu_lights));
+    let n = set.patches.len();
+    let (b, transport) = if manifest.file(super::transport::FILE).is_some() {
+        let m = super::transport::read(dir)?;
+        check_patches(dir, super::transport::FILE, m.n, n)?;
+        (gather_dense(&m.data, m.channels, n, &e), "dense")
+    } else if manifest.file(super::encoded::TRANSFER_FILE).is_some() {
+        let enc = super::encoded::read(dir)?;
+        check_patches(dir, super::encoded::TRANSFER_FILE, enc.dense.n, n)?;
+        let ch = enc.dense.channels;
+        let flat: Vec<f32> = (0..ch).flat_map(|c| e.iter().map(move |v| v[c])).collect();
+        let g = crate::compress::gather(&enc, &flat);
+        let b = (0..n)
+            .map(|i| std::array::from_fn(|c| g[c.min(ch - 1) * n + i]))
+            .collect();
+        (b, "encoded")
+    } else {
+        (vec![[0.0; 3]; n], "none (direct light only)")
+    };
+    let indirect = corner_indirect(&set, &b);
+    // Shading data per corner as the player draws it (emitters lifted off their wall).
+    let verts = corner_vertices(&scene);
+    let visible = rs.visible(&gpu_lights);
+    let shade = |t: usize, w: [f32; 3]| -> [f32; 3] {
+        let at = |k: usize, f: usize| Vec3::from_slice(&verts[12 * (3 * t + k) + f..][..3]);
+        let blend = |f: usize| at(0, f) * w[0] + at(1, f) * w[1] + at(2, f) * w[2];
+        let ind = (0..3)
+            .map(|k| Vec3::from_slice(&indirect[3 * (3 * t + k)..][..3]) * w[k])
+            .sum();
+        shade_point(
+            s,
+            &gpu_lights,
+            blend(0),
+            at(0, 3),
+            at(0, 6),
+            at(0, 9),
+            ind,
+            &visible,
+        )
+        .to_array()
+    };
+    let (lo, hi) = scene.bounds();
+    let max_edge = setup.max_edge.unwrap_or((hi - lo).length() / 32.0);
+    let (glb, mut report) = build_glb(&scene, &shade, Some(max_edge), s.exposure)?;
+    super::images::write_atomic(out, |tmp| {
+        std::fs::write(tmp, &glb).map_err(|e| Error::io(tmp, "cannot write", e))
+    })?;
+    report.out = out.display().to_string();
+    report.bytes = glb.len() as u64;
+    report.lights = lights.len();
+    report.transport = transport;
+    Ok(report)
+}
+
+/// One scene triangle split m × m: its grid's positions and radiances, and m.
+type SplitTriangle = (Vec<[f32; 3]>, Vec<[f32; 3]>, usize);
+
+/// A transport of `got` patches in a bake of `want`: files of different bakes.
+fn check_patches(dir: &Path, file: &str, got: usize, want: usize) -> Result<()> {
+    if got == want {
+        return Ok(());
+    }
+    Err(Error::input(
+        dir.join(file),
+        format!(
+            "is the transport of {got} patches, but {} holds {want}: files of different bakes",
+            super::patches::FILE
+        ),
+    ))
+}
+
+/// The GLB bytes of `scene` with radiance `shade(t, w)` at barycentric weights `w` of
+/// triangle t; triangles longer than `max_edge` are split into m² sub-triangles (m ≤
+/// [`MAX_SPLIT`]).
+pub fn build_glb(
+    scene: &Scene,
+    shade: &(dyn Fn(usize, [f32; 3]) -> [f32; 3] + Sync),
+    max_edge: Option<f32>,
+    exposure: f32,
+) -> Result<(Vec<u8>, LitReport)> {
+    use rayon::prelude::*;
+    let degenerate: std::collections::BTreeSet<usize> = scene.degenerate_triangles().collect();
+    let mut bin: Vec<u8> = Vec::new();
+    let (mut views, mut accessors, mut meshes, mut nodes) = (vec![], vec![], vec![], vec![]);
+    let mut push_view = |bin: &mut Vec<u8>, bytes: Vec<u8>, target: u32| -> usize {
+        let offset = bin.len();
+        let len = bytes.len();
+        bin.extend(bytes);
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": len, "target": target}));
+        views.len() - 1
+    };
+    let (mut clamped, mut channels, mut max_radiance) = (0usize, 0usize, 0.0f32);
+    let (mut triangles, mut vertices) = (0usize, 0usize);
+    for (o, name) in scene.objects.iter().enumerate() {
+        let tris: Vec<usize> = (0..scene.triangles.len())
+            .filter(|&t| scene.triangle_object[t] as usize == o && !degenerate.contains(&t))
+            .collect();
+        if tris.is_empty() {
+            continue;
+        }
+        // Per triangle: its grid vertices (barycentric (1 − (i + j)/m, i/m, j/m)) shaded in
+        // parallel, then indices into the object's vertex list.
+        let parts: Vec<SplitTriangle> = tris
+            .par_iter()
+            .map(|&t| {
+                let c = scene.corners(t);
+                let longest = (0..3)
+                    .map(|k| (c[(k + 1) % 3] - c[k]).length())
+                    .fold(0.0, f32::max);
+                let m = max_edge.map_or(1, |e| ((longest / e).ceil() as usize).clamp(1, MAX_SPLIT));
+                let (mut pos, mut rad) = (vec![], vec![]);
+                for i in 0..=m {
+                    for j in 0..=m - i {
+                        let (u, v) = (i as f32 / m as f32, j as f32 / m as f32);
+                        let w = [1.0 - u - v, u, v];
+                        pos.push((c[0] * w[0] + c[1] * w[1] + c[2] * w[2]).to_array());
+                        rad.push(shade(t, w));
+                    }
+                }
+                (pos, rad, m)
+            })
+            .collect();
+        let (mut pos, mut nor, mut col, mut rad, mut idx) =
+            (vec![], vec![], vec![], vec![], vec![]);
+        for (&t, (p, r, m)) in tris.iter().zip(&parts) {
+            let c = scene.corners(t);
+            let nrm = (c[1] - c[0]).cross(c[2] - c[0]).normalize().to_array();
+            let base = (pos.len() / 3) as u32;
+            // Vertex (i, j) is at offset row(i) + j, row(i) = Σ_{a<i} (m + 1 − a).
+            let row = |i: usize| (i * (2 * m + 3) - i * i) / 2;
+            for i in 0..*m {
+                for j in 0..m - i {
+                    let (a, b, d) = (row(i) + j, row(i + 1) + j, row(i) + j + 1);
+                    idx.extend([a, b, d].map(|v| base + v as u32));
+                    if j + 1 < m - i {
+                        let e = row(i + 1) + j + 1;
+                        idx.extend([b, e, d].map(|v| base + v as u32));
+                    }
+                }
+            }
+            triangles += m * m;
+            for (pp, rr) in p.iter().zip(r) {
+                pos.extend_from_slice(pp);
+                nor.extend_from_slice(&nrm);
+                for &v in rr {
+                    if !v.is_finite() {
+                        return Err(Error::Internal(format!("radiance {v} at triangle {t}")));
+                    }
+                    max_radiance = max_radiance.max(v);
+                    let x = v * exposure;
+                    clamped += (x > 1.0) as usize;
+                    channels += 1;
+                    col.push(x.clamp(0.0, 1.0));
+                }
+                rad.extend_from_slice(rr);
+            }
+        }
+        let count = pos.len() / 3;
+        vertices += count;
+        let (lo, hi) = pos.chunks_exact(3).fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| {
+                let p = Vec3::from_slice(p);
+                (lo.min(p), hi.max(p))
+            },
+        );
+        let floats = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        let mut attr = serde_json::Map::new();
+        for (name, data, bounds) in [
+            ("POSITION", &pos, Some((lo, hi))),
+            ("NORMAL", &nor, None),
+            ("COLOR_0", &col, None),
+            ("_RADIANCE", &rad, None),
+        ] {
+            let view = push_view(&mut bin, floats(data), 34962);
+            let mut acc =
+                json!({"bufferView": view, "componentType": 5126, "count": count, "type": "VEC3"});
+            if let Some((lo, hi)) = bounds {
+                acc["min"] = json!(lo.to_array());
+                acc["max"] = json!(hi.to_array());
+            }
+            accessors.push(acc);
+            attr.insert(name.into(), json!(accessors.len() - 1));
+        }
+        let view = push_view(
+            &mut bin,
+            idx.iter().flat_map(|i| i.to_le_bytes()).collect(),
+            34963,
+        );
+        accessors.push(json!({"bufferView": view, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}));
+        let indices = accessors.len() - 1;
+        meshes.push(json!({"name": name, "primitives": [{"attributes": attr, "indices": indices, "material": 0, "mode": 4}]}));
+        nodes.push(json!({"name": name, "mesh": meshes.len() - 1}));
+    }
+    if nodes.is_empty() {
+        return Err(Error::input(
+            super::scene::FILE,
+            "the scene has no triangle that is not degenerate",
+        ));
+    }
+    let node_ids: Vec<usize> = (0..nodes.len()).collect();
+    let doc: Value = json!({
+        "asset": {"version": "2.0", "generator": format!("relume-bake {}", env!("CARGO_PKG_VERSION"))},
+        "extensionsUsed": ["KHR_materials_unlit"],
+        "scene": 0,
+        "scenes": [{"nodes": node_ids, "extras": {"relume": {
+            "lighting": "baked radiosity: direct + indirect + emission per vertex (linear)",
+            "COLOR_0": "radiance x exposure, clamped to [0, 1]",
+            "_RADIANCE": "linear outgoing radiance, unclamped",
+            "exposure": exposure,
+        }}}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": [{
+            "name": "baked light (unlit)",
+            "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
+            "doubleSided": true,
+            "extensions": {"KHR_materials_unlit": {}},
+        }],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": views,
+        "accessors": accessors,
+    });
+    let json = serde_json::to_vec(&doc)
+        .map_err(|e| Error::Internal(format!("cannot encode glTF JSON: {e}")))?;
+    let glb = ::gltf::binary::Glb {
+        header: ::gltf::binary::Header {
+            magic: *b"glTF",
+            version: 2,
+            length: 0, // to_vec computes the real length
+        },
+        json: std::borrow::Cow::Owned(json),
+        bin: Some(std::borrow::Cow::Owned(bin)),
+    }
+    .to_vec()
+    .map_err(|e| Error::Internal(format!("cannot write GLB: {e}")))?;
+    let report = LitReport {
+        out: String::new(),
+        bytes: 0,
+        objects: meshes.len(),
+        scene_triangles: scene.triangles.len() - degenerate.len(),
+        triangles,
+        vertices,
+        degenerate_triangles_left_out: degenerate.len(),
+        lights: 0,
+        transport: "",
+        max_radiance,
+        clamped_fraction: clamped as f64 / channels.max(1) as f64,
+    };
+    Ok((glb, report))
+}
