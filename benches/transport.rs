@@ -6,7 +6,9 @@
 
 use relume::progress::Silent;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
-use relume::radiosity::transport::{products, transport, Bounces, Power, TransportParams};
+use relume::radiosity::transport::{
+    products, transport, Bounces, InfiniteSolver, Power, TransportParams,
+};
 use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use std::time::Instant;
 
@@ -49,7 +51,7 @@ fn main() {
     );
     println!("| bounces | method | matrix products | seconds | GFLOP/s |");
     println!("|---|---|---|---|---|");
-    let run = |bounces: Bounces, power: Power, label: &str| {
+    let run_with = |bounces: Bounces, power: Power, solver: InfiniteSolver, label: &str| {
         let t = Instant::now();
         let s = transport(
             &f.values,
@@ -59,6 +61,7 @@ fn main() {
                 bounces,
                 power,
                 max_memory: u64::MAX,
+                solver,
             },
             &Silent,
         )
@@ -74,6 +77,31 @@ fn main() {
             flops / secs / 1e9
         );
         std::hint::black_box(s.data[0]);
+        secs
+    };
+    let run = |bounces: Bounces, power: Power, label: &str| {
+        run_with(bounces, power, InfiniteSolver::Auto, label)
+    };
+    // One f32 GEMM (faer, the transport's own) on matrices of this size: the unit of k = ∞.
+    let gemm = {
+        let a = faer::Mat::<f32>::from_fn(n, n, |i, j| f.values[i * n + j]);
+        let mut c = faer::Mat::<f32>::zeros(n, n);
+        let t = Instant::now();
+        faer::linalg::matmul::matmul(
+            c.as_mut(),
+            faer::Accum::Replace,
+            a.as_ref(),
+            a.as_ref(),
+            1.0f32,
+            faer::Par::rayon(0),
+        );
+        let secs = t.elapsed().as_secs_f64();
+        std::hint::black_box(c[(0, 0)]);
+        println!(
+            "| one f32 GEMM (faer) | — | 1 | {secs:.2} | {:.1} |",
+            2.0 * n3 / secs / 1e9
+        );
+        secs
     };
     for k in [1u32, 3, 8, 16] {
         let (h, d) = products(k);
@@ -82,7 +110,23 @@ fn main() {
             run(Bounces::Finite(k), Power::Doubling, &format!("k = {k}"));
         }
     }
-    run(Bounces::Infinite, Power::Auto, "k = ∞ (LU, f64)");
+    let f32_lu = run_with(
+        Bounces::Infinite,
+        Power::Auto,
+        InfiniteSolver::F32,
+        "k = ∞ (LU, f32, the default when accurate)",
+    );
+    let f64_lu = run_with(
+        Bounces::Infinite,
+        Power::Auto,
+        InfiniteSolver::F64,
+        "k = ∞ (LU, f64, the reference)",
+    );
+    println!(
+        "\nk = ∞ in units of one f32 GEMM (faer) of this run: f32 LU {:.2}, f64 LU {:.2}\n",
+        f32_lu / gemm,
+        f64_lu / gemm
+    );
     run(Bounces::Auto(1e-3), Power::Auto, "Auto(1e-3)");
     // Baseline: numpy / OpenBLAS on the same size.
     let code = format!(

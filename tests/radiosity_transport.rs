@@ -6,7 +6,9 @@ use relume::progress::Silent;
 use relume::radiosity::fixtures;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
 use relume::radiosity::reference::gauss_seidel;
-use relume::radiosity::transport::{transport, Bounces, Power, Transport, TransportParams};
+use relume::radiosity::transport::{
+    transport, Bounces, InfiniteSolver, Power, Transport, TransportParams, F32_ACCEPT,
+};
 use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 
@@ -57,6 +59,7 @@ fn run(
             bounces,
             power,
             max_memory: BIG,
+            solver: Default::default(),
         },
         &Silent,
     )
@@ -229,6 +232,7 @@ fn memory_budget_is_checked_before_allocating() {
             bounces: Bounces::Infinite,
             power: Power::Auto,
             max_memory: 1000,
+            solver: Default::default(),
         },
         &Silent,
     )
@@ -281,6 +285,84 @@ proptest! {
         let far = run(&f, n, &albedo, Bounces::Finite(400), Power::Auto).unwrap();
         for (a, b) in far.data.iter().zip(&inf.data) {
             prop_assert!((a - b).abs() <= 1e-4);
+        }
+    }
+}
+
+fn infinite_with(f: &[f32], n: usize, albedo: &[[f32; 3]], solver: InfiniteSolver) -> Transport {
+    transport(
+        f,
+        n,
+        albedo,
+        &TransportParams {
+            bounces: Bounces::Infinite,
+            power: Power::Auto,
+            max_memory: BIG,
+            solver,
+        },
+        &Silent,
+    )
+    .unwrap()
+}
+
+/// The largest |a − b| over the largest |b|.
+fn rel_err(a: &[f32], b: &[f32]) -> f64 {
+    let top = b.iter().fold(0f64, |m, v| m.max(v.abs() as f64));
+    let worst = a
+        .iter()
+        .zip(b)
+        .fold(0f64, |m, (x, y)| m.max((*x as f64 - *y as f64).abs()));
+    worst / top
+}
+
+#[test]
+fn the_f32_solve_matches_the_f64_reference_or_gives_way_to_it() {
+    // The Cornell box (coloured: three channels) and closed furnaces from ρ = 0.5 to 0.999.
+    let cornell = relume::scene::load_scene(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes/cornell-box/cornell_box.obj"),
+        relume::scene::SceneOptions { scale: 0.001 },
+    )
+    .unwrap()
+    .0;
+    let mut cases = vec![(
+        "cornell".to_string(),
+        bake(&cornell, Resolution::TargetPatches(400)),
+    )];
+    for rho in [0.5f32, 0.9, 0.99, 0.999] {
+        let scene = fixtures::closed_box([1.0, 0.5, 0.75], rho, 1.0);
+        cases.push((
+            format!("furnace {rho}"),
+            bake(&scene, Resolution::VoxelSize(0.125)),
+        ));
+    }
+    for (name, (albedo, _, f, n)) in &cases {
+        let reference = infinite_with(f, *n, albedo, InfiniteSolver::F64);
+        let auto = infinite_with(f, *n, albedo, InfiniteSolver::Auto);
+        let forced = infinite_with(f, *n, albedo, InfiniteSolver::F32);
+        let e_auto = rel_err(&auto.data, &reference.data);
+        let e_f32 = rel_err(&forced.data, &reference.data);
+        let (solver, estimate) = auto.solvers[0];
+        let estimate_f32 = forced.solvers[0].1;
+        eprintln!(
+            "{name} (n = {n}): auto chose {solver:?}; f32 error {e_f32:.2e}, estimated {estimate_f32:.2e}"
+        );
+        // Whatever Auto chose is within the 1e-5 of the f64 reference.
+        assert!(e_auto <= 1e-5, "{name}: {e_auto}");
+        // The estimate tracks the real error: within a factor of 10 either way above the f32
+        // rounding of S's entries (6e-8).
+        assert!(
+            e_f32 <= 10.0 * estimate_f32 + 1e-6 && estimate_f32 <= 10.0 * e_f32 + 1e-6,
+            "{name}: error {e_f32} vs estimate {estimate_f32}"
+        );
+        // Auto keeps the f32 solve exactly when its estimate passes.
+        assert_eq!(
+            solver == InfiniteSolver::F32,
+            estimate_f32 <= F32_ACCEPT,
+            "{name}"
+        );
+        if solver == InfiniteSolver::F32 {
+            assert_eq!(estimate, estimate_f32);
         }
     }
 }

@@ -280,6 +280,7 @@ fn no_light_leaks_through_a_wall_thinner_than_a_voxel() {
             bounces: Bounces::Infinite,
             power: Power::Auto,
             max_memory: 1 << 40,
+            solver: Default::default(),
         },
         &Silent,
     )

@@ -19,6 +19,7 @@ pub mod corners;
 pub mod fixtures;
 pub mod formfactor;
 pub mod geometry;
+pub mod infinite;
 pub mod locate;
 pub mod matrix;
 pub mod overlap;

@@ -3,8 +3,9 @@
 //! `S_k = Σ_{h=1..k} M^h`,  `M = diag(ρ) F`,  so that the indirect light of direct exitance E is
 //! `B_indirect = S_k · E` (the radiosity thesis's `F^{k-reflections}`, §4.1, with its "colour matrix" `F^C = M`),
 //!
-//! and the limit `S_∞ = M (I − M)^{-1} = (I − M)^{-1} M`, solved by one LU factorisation (f64,
-//! partial pivoting, faer). Finite k uses f32 GEMMs (faer) by Horner's rule
+//! and the limit `S_∞ = M (I − M)^{-1} = (I − M)^{-1} M`, by one LU factorisation (partial
+//! pivoting, faer) in f32 checked a posteriori, or in f64 when the check fails
+//! ([`super::infinite`]). Finite k uses f32 GEMMs (faer) by Horner's rule
 //! (`S ← M + M·S`, k − 1 products) or binary doubling (`S_2m = S_m + M^m S_m`,
 //! `S_{m+1} = M + M S_m`, about 2 log2 k products); `Power::Auto` takes the one with fewer
 //! products (Horner on ties; the benchmark in benches/transport.rs measures both).
@@ -15,12 +16,13 @@
 //! clear message, a matrix whose spectral radius is (numerically) 1 or more — a closed scene with
 //! albedo 1 never loses energy — instead of returning huge or NaN entries.
 
+use super::infinite::{from_fn_tiled, infinite, to_row_major, RowMajor, F32_BYTES_PER_ENTRY};
+pub use super::infinite::{spectral_bounds, InfiniteSolver, F32_ACCEPT};
 use super::TransportMatrix;
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::progress::Progress;
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::Solve;
 use faer::{Accum, Mat, Par};
 use serde::{Deserialize, Serialize};
 
@@ -59,6 +61,8 @@ pub struct TransportParams {
     pub power: Power,
     /// Memory budget in bytes (`--max-memory`).
     pub max_memory: u64,
+    /// How infinite bounces are solved.
+    pub solver: InfiniteSolver,
 }
 
 /// The transport matrices of every modelled channel, with what computing them took.
@@ -73,6 +77,9 @@ pub struct Transport {
     /// Collatz–Wielandt bounds on the spectral radius of M per channel (lower, upper); computed
     /// for Infinite and Auto only.
     pub spectral_bounds: Vec<(f64, f64)>,
+    /// Infinite only, per channel: which LU solved it and the f32 solve's estimated relative
+    /// error ([`super::infinite`]).
+    pub solvers: Vec<(InfiniteSolver, f64)>,
 }
 
 /// A transport is its matrix plus how it was computed: `t.channels`, `t.apply(..)` read the
@@ -86,14 +93,12 @@ impl std::ops::Deref for Transport {
 
 /// Estimated peak bytes of [`transport`]: the form factors, the output, and the working
 /// matrices of one channel (finite and Auto: up to four f32 matrices — M, S, M^j or the newest
-/// bounce, scratch; infinite: M in f32 and, while faer solves, the f64 LU factor, the f64
-/// solution and faer's f64 row-permutation scratch of the right-hand side, 28 bytes per entry,
-/// plus 2 bytes per entry of slack: 30 in all, against 33 and 34 bytes per entry measured (peak
-/// RSS less the form factors and the output) on 3- and 1-channel bakes of about 4,000 patches).
+/// bounce, scratch; infinite: the f32 solve's [`F32_BYTES_PER_ENTRY`]; when the f32 solve is
+/// not accurate enough, the f64 one's larger need is checked against the budget again first).
 pub fn memory_estimate(n: usize, channels: usize, bounces: Bounces) -> u64 {
     let n2 = (n * n) as u64;
     let working = match bounces {
-        Bounces::Infinite => n2 * 30,
+        Bounces::Infinite => n2 * F32_BYTES_PER_ENTRY,
         _ => n2 * 4 * 4,
     };
     n2 * 4 + channels as u64 * n2 * 4 + working
@@ -136,11 +141,12 @@ pub fn transport(
         bounces: Vec::new(),
         products: 0,
         spectral_bounds: Vec::new(),
+        solvers: Vec::new(),
     };
     progress.begin("transport", channels as u64);
     for c in 0..channels {
         let rho: Vec<f32> = albedo.iter().map(|a| a[c]).collect();
-        let m = Mat::<f32>::from_fn(n, n, |i, j| rho[i] * f[i * n + j]);
+        let m = from_fn_tiled(n, |i, j| rho[i] * f[i * n + j]);
         let (s, k, products) = match params.bounces {
             Bounces::Finite(k) => {
                 let (s, p) = power_sum(&m, k, params.power);
@@ -156,14 +162,23 @@ pub fn transport(
                 let bounds = spectral_bounds(&m);
                 out.spectral_bounds.push(bounds);
                 refuse_divergent(bounds, "Infinite")?;
-                (infinite(&m)?, 0, 0)
+                let n2 = (n * n) as u64;
+                let check = |bytes: u64, why: String| {
+                    limits::check_memory(
+                        &why,
+                        n2 * 4 + channels as u64 * n2 * 4 + bytes,
+                        params.max_memory,
+                    )
+                };
+                let rows = RowMajor { f, rho: &rho };
+                let (s, solver, err) = infinite(&m, rows, params.solver, &check)?;
+                out.solvers.push((solver, err));
+                (s, 0, 0)
             }
         };
         out.bounces.push(k);
         out.products += products;
-        for i in 0..n {
-            values.extend((0..n).map(|j| s[(i, j)]));
-        }
+        values.extend(to_row_major(&s));
         progress.advance(1);
     }
     progress.finish();
@@ -292,78 +307,6 @@ fn auto_sum(m: &Mat<f32>, tol: f64) -> Result<(Mat<f32>, u32, u32)> {
         products += 1;
     }
     Ok((s, k, products))
-}
-
-/// `(I − M)^{-1} M` by LU with partial pivoting in f64.
-fn infinite(m: &Mat<f32>) -> Result<Mat<f32>> {
-    let n = m.nrows();
-    let a = Mat::<f64>::from_fn(n, n, |i, j| f64::from(i == j) - m[(i, j)] as f64);
-    let lu = a.partial_piv_lu();
-    drop(a);
-    let u = lu.U();
-    let (mut lo, mut hi) = (f64::INFINITY, 0f64);
-    for i in 0..n {
-        let d = u[(i, i)].abs();
-        lo = lo.min(d);
-        hi = hi.max(d);
-    }
-    if !(lo.is_finite() && hi.is_finite()) || lo <= 1e-12 * hi.max(1.0) {
-        return Err(Error::knob(format!(
-            "transport: I − diag(albedo)·F is singular (smallest LU pivot {lo:e}): infinite bounces diverge; use `bounces: Finite(k)`"
-        )));
-    }
-    let mut x = Mat::<f64>::from_fn(n, n, |i, j| m[(i, j)] as f64);
-    lu.solve_in_place(x.as_mut());
-    let mut s = Mat::<f32>::zeros(n, n);
-    for j in 0..n {
-        for i in 0..n {
-            let v = x[(i, j)];
-            if !v.is_finite() {
-                return Err(Error::knob(
-                    "transport: the infinite-bounce solve produced a non-finite value; use `bounces: Finite(k)`",
-                ));
-            }
-            // S is non-negative in exact arithmetic; clamp rounding noise around zeros.
-            s[(i, j)] = v.max(0.0) as f32;
-        }
-    }
-    Ok(s)
-}
-
-/// Collatz–Wielandt bounds (lower, upper) on the spectral radius of a non-negative matrix, from
-/// 64 steps of power iteration started at the all-ones vector.
-pub fn spectral_bounds(m: &Mat<f32>) -> (f64, f64) {
-    let n = m.nrows();
-    let mut x = vec![1f64; n];
-    let mut bounds: (f64, f64) = (0.0, f64::INFINITY);
-    for _ in 0..64 {
-        let mut y = vec![0f64; n];
-        for j in 0..n {
-            let xj = x[j];
-            if xj != 0.0 {
-                for (i, yi) in y.iter_mut().enumerate() {
-                    *yi += m[(i, j)] as f64 * xj;
-                }
-            }
-        }
-        let (mut lo, mut hi) = (f64::INFINITY, 0f64);
-        for i in 0..n {
-            if x[i] > 0.0 {
-                let r = y[i] / x[i];
-                lo = lo.min(r);
-                hi = hi.max(r);
-            }
-        }
-        if lo.is_finite() {
-            bounds = (bounds.0.max(lo), bounds.1.min(hi));
-        }
-        let top = y.iter().copied().fold(0.0, f64::max);
-        if top <= 0.0 {
-            return (0.0, 0.0);
-        }
-        x = y.into_iter().map(|v| v / top).collect();
-    }
-    bounds
 }
 
 #[cfg(test)]

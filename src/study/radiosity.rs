@@ -143,6 +143,7 @@ pub fn transport_of(set: &PatchSet, f: &FormFactors, bounces: Bounces) -> Result
             bounces,
             power: Power::Auto,
             max_memory: default_max_memory(),
+            solver: Default::default(),
         },
         &Silent,
     )

@@ -215,6 +215,7 @@ impl StageRun for TransportKnobs {
                 bounces: self.bounces,
                 power: self.power,
                 max_memory: budget,
+                solver: Default::default(),
             },
             progress,
         )?;
@@ -230,6 +231,12 @@ impl StageRun for TransportKnobs {
         for (c, (lo, hi)) in t.spectral_bounds.iter().enumerate() {
             rec.report.insert(format!("spectral_radius_low_{c}"), *lo);
             rec.report.insert(format!("spectral_radius_high_{c}"), *hi);
+        }
+        for (c, (solver, err)) in t.solvers.iter().enumerate() {
+            rec.facts
+                .insert(format!("solver_{c}"), format!("{solver:?} LU"));
+            rec.report
+                .insert(format!("solver_error_estimate_{c}"), *err);
         }
         let max = t.matrix.data.iter().copied().fold(0f32, f32::max);
         rec.report.insert("max_entry".into(), max as f64);
