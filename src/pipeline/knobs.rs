@@ -35,7 +35,7 @@ pub struct VoxelizeKnobs {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FormFactorsKnobs {
-    /// `Hemisphere` (default) or `Pairwise`.
+    /// `HemisphereReciprocal` (default), `Hemisphere` or `Pairwise`.
     #[serde(default)]
     pub estimator: Estimator,
     /// Rays per patch (hemisphere, default 4096) or point pairs per patch pair (pairwise,
@@ -75,7 +75,7 @@ impl Default for VoxelizeKnobs {
 impl Default for FormFactorsKnobs {
     fn default() -> Self {
         FormFactorsKnobs {
-            estimator: Estimator::Hemisphere,
+            estimator: Estimator::HemisphereReciprocal,
             samples: None,
             seed: 0,
         }

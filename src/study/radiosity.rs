@@ -324,6 +324,10 @@ pub fn estimator_sweep(
     hemi.dedup();
     hemi.retain(|&s| s != cfg.reference_samples);
     runs.extend(hemi.iter().map(|&s| (Estimator::Hemisphere, s, false)));
+    runs.extend(
+        hemi.iter()
+            .map(|&s| (Estimator::HemisphereReciprocal, s, false)),
+    );
     let mut pair = cfg.pairwise_samples.clone();
     pair.sort_unstable();
     pair.dedup();
@@ -353,7 +357,7 @@ pub fn estimator_sweep(
         name: "radiosity_estimator".into(),
         title: "Radiosity: form-factor estimator".into(),
         description: format!(
-            "{n} patches (target {}); hemisphere rays per patch {hemi:?}, pairwise point pairs per patch pair {pair:?}, seed {}; infinite bounces",
+            "{n} patches (target {}); hemisphere rays per patch {hemi:?} (plain and with reciprocity averaging), pairwise point pairs per patch pair {pair:?}, seed {}; infinite bounces",
             cfg.fixed_patches, cfg.seed
         ),
         reference: format!(
@@ -365,7 +369,10 @@ pub fn estimator_sweep(
         ..Default::default()
     };
     for (estimator, samples, is_ref, f, secs, t_secs, light) in &measured {
-        let name = format!("{estimator:?}").to_lowercase();
+        let name = match estimator {
+            Estimator::HemisphereReciprocal => "hemisphere reciprocal".to_string(),
+            e => format!("{e:?}").to_lowercase(),
+        };
         let ff = FormFactorsKnobs::default();
         let mut s = Setting::new(format!("{name} {samples}"), name.clone())
             .default_if(*estimator == ff.estimator && *samples == ff.samples())

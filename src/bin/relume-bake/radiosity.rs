@@ -43,7 +43,7 @@ pub enum Command {
     FormFactors {
         /// Baked directory with patches
         baked_dir: PathBuf,
-        /// Estimator (default: hemisphere)
+        /// Estimator (default: hemisphere-reciprocal)
         #[arg(long, value_enum)]
         estimator: Option<Estimator>,
         /// Rays per patch (hemisphere, default 4096) or point pairs per patch pair (pairwise, default 16)

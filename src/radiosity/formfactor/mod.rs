@@ -7,7 +7,9 @@
 //! [`hemisphere`] shooting (the default: N cosine-distributed rays per patch, `F_ij ≈ hits_j / N`,
 //! rows sum to the unoccluded fraction by construction, cost n·N rays) and [`pairwise`]
 //! area-to-area (N stratified point pairs per patch pair, one visibility ray each, exactly
-//! reciprocal, cost n²·N/2 rays). [`analytic`] holds closed-form configuration factors for tests.
+//! reciprocal, cost n²·N/2 rays), and [`reciprocal`] averaging of the hemisphere estimate
+//! (the two independent estimates of each pair's throughput averaged; no extra rays).
+//! [`analytic`] holds closed-form configuration factors for tests.
 //!
 //! Both are parallel over patches (rayon) with one seeded random stream per patch (or patch
 //! pair): the matrix is byte-identical for any thread count.
@@ -15,6 +17,7 @@
 pub mod analytic;
 pub mod hemisphere;
 pub mod pairwise;
+pub mod reciprocal;
 
 use super::locate::PatchLocator;
 use super::visibility::Visibility;
@@ -29,17 +32,22 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 pub enum Estimator {
     /// N cosine-distributed rays from each patch (N = samples).
-    #[default]
     Hemisphere,
     /// N stratified point pairs per pair of patches, one visibility ray each.
     Pairwise,
+    /// Hemisphere shooting, then reciprocity averaging with inverse-variance weights:
+    /// `F_ij = A_j (F_ij + F_ji) / (A_i + A_j)`, each row scaled back to the hits' row sum ([`reciprocal`]). The
+    /// default: 10–27 % less error in the gathered light than `Hemisphere` with the same rays,
+    /// at no extra cost (`relume-bake study radiosity`, docs/radiosity.md).
+    #[default]
+    HemisphereReciprocal,
 }
 
 impl Estimator {
     /// Default samples: rays per patch (hemisphere) or point pairs per patch pair (pairwise).
     pub fn default_samples(self) -> u32 {
         match self {
-            Estimator::Hemisphere => 4096,
+            Estimator::Hemisphere | Estimator::HemisphereReciprocal => 4096,
             Estimator::Pairwise => 16,
         }
     }
@@ -115,6 +123,12 @@ pub fn form_factors(
     let ctx = Context::new(scene, set);
     Ok(match params.estimator {
         Estimator::Hemisphere => hemisphere::estimate(&ctx, params.samples, params.seed, progress),
+        Estimator::HemisphereReciprocal => {
+            let mut f = hemisphere::estimate(&ctx, params.samples, params.seed, progress);
+            let areas: Vec<f64> = ctx.samplers.iter().map(|s| s.area).collect();
+            reciprocal::average(&mut f.values, &areas);
+            f
+        }
         Estimator::Pairwise => pairwise::estimate(&ctx, params.samples, params.seed, progress),
     })
 }
