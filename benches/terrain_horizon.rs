@@ -35,13 +35,7 @@ fn main() {
         let (_, max) = map.min_max();
         for &k in &counts {
             let t = Instant::now();
-            let hm = HorizonMap::build(
-                &map,
-                &HorizonSettings {
-                    directions: k,
-                    planet_radius: None,
-                },
-            );
+            let hm = HorizonMap::build(&map, &HorizonSettings::flat(k));
             let secs = t.elapsed().as_secs_f64();
             let stride = if n >= 4096 { 16 } else { 8 };
             let pixels: Vec<(usize, usize)> = (0..map.height)

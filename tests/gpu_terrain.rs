@@ -107,35 +107,32 @@ fn gpu_hard_shadow_masks_match_the_cpu_on_real_dems() {
     }
 }
 
-#[test]
-fn map_view_matches_the_cpu_shading() {
-    let Some(gpu) = gpu() else { return };
-    let map = srtm_half();
-    let mip = MinMaxMipmap::build(&map);
-    let (w, h) = (map.width as u32, map.height as u32);
-    let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
-    let sun = Sun::new(300.0, 12.0).unwrap();
-    r.set_sun(&gpu, sun);
+/// The top-down map view of `r` (one pixel per texel of `map`, no fog, true scale) under
+/// `sun` against `render::terrain_shading::map_view` with the per-texel `shadow` the GPU is
+/// expected to use: (mean, max) absolute difference per 8-bit channel over interior pixels
+/// (the mesh's vertices sit at texel centres, so the outer half texel is not covered).
+fn map_view_difference(
+    gpu: &Gpu,
+    r: &mut TerrainRenderer,
+    map: &HeightMap,
+    sun: Sun,
+    shadow: impl Fn(&TerrainRenderer) -> Vec<bool>,
+) -> (f64, u8) {
+    r.set_sun(gpu, sun);
     let s = TerrainSettings {
         fog: false,
         vertical_exaggeration: 1.0,
         ..Default::default()
     };
     let (view_proj, eye) = r.map_view();
-    let mut timer = PassTimer::new(&gpu, 2);
+    let mut timer = PassTimer::new(gpu, 2);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    r.record(&gpu, &mut enc, view_proj, eye, &s, &mut timer);
+    r.record(gpu, &mut enc, view_proj, eye, &s, &mut timer);
     gpu.queue.submit([enc.finish()]);
-    let img = r.target.read_image(&gpu).unwrap();
-    let shadow: Vec<f32> = r
-        .shadow_mask(&gpu, true)
-        .unwrap()
-        .iter()
-        .map(|&b| b as u8 as f32)
-        .collect();
-    let want = map_view(&map, &sun, &shadow, &s);
-    // Interior pixels only: the mesh's vertices sit at texel centres, so the outer half texel
-    // of the map is not covered.
+    let img = r.target.read_image(gpu).unwrap();
+    let shadow: Vec<f32> = shadow(r).iter().map(|&b| b as u8 as f32).collect();
+    let want = map_view(map, &sun, &shadow, &s);
+    let (w, h) = (map.width as u32, map.height as u32);
     let (mut sum, mut n, mut worst) = (0u64, 0u64, 0u8);
     for y in 1..h - 1 {
         for x in 1..w - 1 {
@@ -148,7 +145,20 @@ fn map_view_matches_the_cpu_shading() {
             n += 3;
         }
     }
-    let mean = sum as f64 / n as f64;
+    (sum as f64 / n as f64, worst)
+}
+
+#[test]
+fn map_view_matches_the_cpu_shading() {
+    let Some(gpu) = gpu() else { return };
+    let map = srtm_half();
+    let mip = MinMaxMipmap::build(&map);
+    let (w, h) = (map.width as u32, map.height as u32);
+    let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
+    let sun = Sun::new(300.0, 12.0).unwrap();
+    let (mean, worst) = map_view_difference(&gpu, &mut r, &map, sun, |r| {
+        r.shadow_mask(&gpu, true).unwrap()
+    });
     eprintln!("terrain map view: mean |GPU − CPU| = {mean:.4}/255, max {worst}/255");
     // Same formulas in f32 on both sides; the GPU's pow/exp differ by ulps, so 8-bit values may
     // differ by one step at rounding boundaries.
@@ -276,13 +286,7 @@ fn gpu_horizon_masks_match_the_twin_and_the_exact_mask() {
     let Some(gpu) = gpu() else { return };
     let map = srtm_half();
     let mip = MinMaxMipmap::build(&map);
-    let hm = HorizonMap::build(
-        &map,
-        &HorizonSettings {
-            directions: 32,
-            planet_radius: None,
-        },
-    );
+    let hm = HorizonMap::build(&map, &HorizonSettings::flat(32));
     let mut r = TerrainRenderer::new(&gpu, &map, &mip, 8, 8, None).unwrap();
     // Before horizon maps are set, method 3 falls back to the accelerated traversal.
     let sun0 = Sun::new(123.0, 7.0).unwrap();
@@ -369,47 +373,15 @@ fn map_view_with_horizon_shadows_matches_the_cpu_shading() {
     let mip = MinMaxMipmap::build(&map);
     let (w, h) = (map.width as u32, map.height as u32);
     let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
-    let hm = HorizonMap::build(
-        &map,
-        &HorizonSettings {
-            directions: 16,
-            planet_radius: None,
-        },
-    );
+    let hm = HorizonMap::build(&map, &HorizonSettings::flat(16));
     r.set_horizon(&gpu, hm.clone()).unwrap();
-    let sun = Sun::new(205.0, 9.0).unwrap();
-    r.set_sun(&gpu, sun);
-    let s = TerrainSettings {
-        fog: false,
-        vertical_exaggeration: 1.0,
-        ..Default::default()
-    };
     assert!(
-        s.horizon,
+        TerrainSettings::default().horizon,
         "horizon shadows are the default when a bake has them"
     );
-    let (view_proj, eye) = r.map_view();
-    let mut timer = PassTimer::new(&gpu, 2);
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    r.record(&gpu, &mut enc, view_proj, eye, &s, &mut timer);
-    gpu.queue.submit([enc.finish()]);
-    let img = r.target.read_image(&gpu).unwrap();
-    let shadow: Vec<f32> = hm
-        .shadow_mask_f32(&sun)
-        .iter()
-        .map(|&b| b as u8 as f32)
-        .collect();
-    let want = map_view(&map, &sun, &shadow, &s);
-    let mut worst = 0u8;
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let (a, b) = (img.get_pixel(x, y), want.get_pixel(x, y));
-            for c in 0..3 {
-                worst = worst.max(a[c].abs_diff(b[c]));
-            }
-        }
-    }
-    eprintln!("terrain map view with horizon shadows: max |GPU − CPU| = {worst}/255");
+    let sun = Sun::new(205.0, 9.0).unwrap();
+    let (mean, worst) = map_view_difference(&gpu, &mut r, &map, sun, |_| hm.shadow_mask_f32(&sun));
+    eprintln!("terrain map view with horizon shadows: mean {mean:.4}/255, max {worst}/255");
     // As in the traversal's map view: one 8-bit step at rounding boundaries.
     assert!(worst <= 1, "max difference {worst}/255");
 }

@@ -112,23 +112,11 @@ fn sky_view_and_shadows_from_the_horizon_map() {
     // Flat ground sees the whole sky; a pit of depth d and radius R (here: the centre of a
     // 9-texel-wide square well) sees less.
     let flat = HeightMap::new(16, 16, vec![0.0; 256], [1.0, 1.0]);
-    let hm = HorizonMap::build(
-        &flat,
-        &HorizonSettings {
-            directions: 16,
-            planet_radius: None,
-        },
-    );
+    let hm = HorizonMap::build(&flat, &HorizonSettings::flat(16));
     assert!(hm.sky_view().iter().all(|&v| (v - 1.0).abs() < 1e-6));
     // Quantisation: at most half a step from the sweep's angle.
     let map = random_map(40, 30, 7, [2.0, 2.0], 30.0);
-    let hm = HorizonMap::build(
-        &map,
-        &HorizonSettings {
-            directions: 32,
-            planet_radius: None,
-        },
-    );
+    let hm = HorizonMap::build(&map, &HorizonSettings::flat(32));
     for (d, plane) in hm.directions.iter().zip(&hm.angles) {
         let sweep = horizon_sweep(&map, d, None);
         for (q, s) in plane.iter().zip(&sweep) {

@@ -41,13 +41,7 @@ fn the_stage_writes_what_numpy_reads_and_the_sweep_computes() {
     let tmp = tempfile::tempdir().unwrap();
     let out = bake_512(tmp.path());
     let map = baked_map(&out);
-    let want = HorizonMap::build(
-        &map,
-        &HorizonSettings {
-            directions: 64,
-            planet_radius: None,
-        },
-    );
+    let want = HorizonMap::build(&map, &HorizonSettings::flat(64));
     let m = relume::baked::Manifest::read(&out).unwrap();
     let got =
         relume::baked::horizon::read(&out, &m, (map.width, map.height), map.cell_size).unwrap();

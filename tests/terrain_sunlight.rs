@@ -121,13 +121,7 @@ fn horizon_hours_agree_with_exact_masks_and_a_wall_casts_its_shadow() {
     let date = Instant::parse("2026-12-21T00:00:00Z").unwrap();
     let place = Place::new(47.6, -122.3, 0.0).unwrap();
     let steps = day_steps(&date, &place, 600.0, 0.0).unwrap();
-    let hm = HorizonMap::build(
-        &map,
-        &HorizonSettings {
-            directions: 64,
-            planet_radius: None,
-        },
-    );
+    let hm = HorizonMap::build(&map, &HorizonSettings::flat(64));
     let (hours, _) = sunlight(&map, &hm, &steps, false);
     let daylight: f64 = steps
         .iter()

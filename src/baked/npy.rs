@@ -16,32 +16,22 @@ pub trait NpyElement: Copy + npyz::Serialize + npyz::AutoSerialize {
     fn from_le(bytes: &[u8]) -> Self;
 }
 
-impl NpyElement for f32 {
-    const DESCR: &'static str = "'<f4'";
-    const SIZE: usize = 4;
-    const NAME: &'static str = "f32";
-    fn from_le(b: &[u8]) -> Self {
-        f32::from_le_bytes(b.try_into().unwrap())
-    }
+macro_rules! npy_element {
+    ($t:ty, $descr:literal, $name:literal) => {
+        impl NpyElement for $t {
+            const DESCR: &'static str = $descr;
+            const SIZE: usize = std::mem::size_of::<$t>();
+            const NAME: &'static str = $name;
+            fn from_le(b: &[u8]) -> Self {
+                <$t>::from_le_bytes(b.try_into().unwrap())
+            }
+        }
+    };
 }
 
-impl NpyElement for u16 {
-    const DESCR: &'static str = "'<u2'";
-    const SIZE: usize = 2;
-    const NAME: &'static str = "u16";
-    fn from_le(b: &[u8]) -> Self {
-        u16::from_le_bytes(b.try_into().unwrap())
-    }
-}
-
-impl NpyElement for i32 {
-    const DESCR: &'static str = "'<i4'";
-    const SIZE: usize = 4;
-    const NAME: &'static str = "i32";
-    fn from_le(b: &[u8]) -> Self {
-        i32::from_le_bytes(b.try_into().unwrap())
-    }
-}
+npy_element!(f32, "'<f4'", "f32");
+npy_element!(u16, "'<u2'", "u16");
+npy_element!(i32, "'<i4'", "i32");
 
 /// Write an f32 array as `.npy` with the given shape (C order).
 pub fn write_npy_f32(path: &Path, shape: &[u64], data: &[f32]) -> Result<()> {

@@ -16,12 +16,19 @@ pub struct HorizonSettings {
     pub planet_radius: Option<f64>,
 }
 
-impl Default for HorizonSettings {
-    fn default() -> Self {
+impl HorizonSettings {
+    /// `directions` azimuths on flat ground.
+    pub fn flat(directions: usize) -> Self {
         HorizonSettings {
-            directions: 64,
+            directions,
             planet_radius: None,
         }
+    }
+}
+
+impl Default for HorizonSettings {
+    fn default() -> Self {
+        HorizonSettings::flat(64)
     }
 }
 
