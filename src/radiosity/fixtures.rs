@@ -109,6 +109,27 @@ impl SceneBuilder {
     }
 }
 
+/// `count` random triangles in the unit cube (each within 0.1 of a random centre; xorshift
+/// from `seed`): the random soup of the visibility and memory tests.
+pub fn random_soup(count: usize, seed: u64) -> Scene {
+    let mut state = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut s = SceneBuilder::new();
+    let m = s.material("grey", [0.5; 3], [0.0; 3]);
+    for _ in 0..count {
+        let c = DVec3::new(next(), next(), next());
+        let mut corner = || c + DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 0.1;
+        let corners = [corner(), corner(), corner()];
+        s.triangle("soup", corners, m);
+    }
+    s.build()
+}
+
 /// Howell C-11: rectangles `a × b` at y = 0 (facing +y) and y = c (facing −y).
 pub fn parallel_rectangles(a: f64, b: f64, c: f64) -> Scene {
     let mut s = SceneBuilder::new();

@@ -33,7 +33,7 @@ pub struct Visibility {
 /// so a hit closer than that to the ray's start is lost — a ray leaving a floor point 1e-5 from a
 /// wall would escape through the wall. Rays therefore start `BACKOFF` behind their origin and only
 /// hits at or beyond `BACKOFF` count.
-const BACKOFF: f32 = 2.5e-4;
+pub const BACKOFF: f32 = 2.5e-4;
 
 /// The closest surface a ray hits.
 #[derive(Clone, Copy, Debug)]
@@ -75,6 +75,15 @@ impl Visibility {
             normals,
             epsilon: ray_epsilon(extent),
         }
+    }
+
+    /// The BVH's triangles as (scene triangle index, vertices in grid coordinates, f32): what
+    /// an independent tracer needs to trace the same rays (tests/visibility_embree.rs).
+    pub fn triangles(&self) -> impl Iterator<Item = (u32, [[f32; 3]; 3])> + '_ {
+        self.ids
+            .iter()
+            .zip(&self.tris)
+            .map(|(&id, t)| (id, [t.v0, t.v1, t.v2].map(|v| [v.x, v.y, v.z])))
     }
 
     /// Number of triangles in the BVH.

@@ -14,6 +14,7 @@
 use super::{Context, FormFactors};
 use crate::progress::Progress;
 use crate::radiosity::geometry::{cosine_direction, item_rng};
+use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -40,23 +41,33 @@ pub fn estimate(ctx: &Context, samples: u32, seed: u64, progress: &dyn Progress)
     }
 }
 
-/// Hit counts per receiving patch for `k` rays from patch `i`.
-pub fn shoot(ctx: &Context, i: usize, k: usize, seed: u64, unassigned: &AtomicU64) -> Vec<u32> {
-    let n = ctx.samplers.len();
-    let mut counts = vec![0u32; n];
+/// The `k` rays patch `i` shoots (grid coordinates): origins lifted one ray epsilon off the
+/// surface, unit cosine-distributed directions; empty for a patch without area. Exactly the
+/// rays [`shoot`] traces (an independent tracer can be given the same ones).
+pub fn rays(ctx: &Context, i: usize, k: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
     let sampler = &ctx.samplers[i];
     if sampler.is_empty() {
-        return counts;
+        return Vec::new();
     }
     let mut rng = item_rng(seed, i as u64, u64::MAX);
     let origins = rng.jittered(k);
     let directions = rng.jittered(k);
-    let mut lost = 0;
     let lift = ctx.vis.epsilon as f64;
-    for s in 0..k {
-        let (origin, normal) = sampler.sample_square(origins[s].0, origins[s].1);
-        let dir = cosine_direction(normal, directions[s].0, directions[s].1);
-        let origin = origin + normal * lift;
+    (0..k)
+        .map(|s| {
+            let (origin, normal) = sampler.sample_square(origins[s].0, origins[s].1);
+            let dir = cosine_direction(normal, directions[s].0, directions[s].1);
+            (origin + normal * lift, dir)
+        })
+        .collect()
+}
+
+/// Hit counts per receiving patch for `k` rays from patch `i`.
+pub fn shoot(ctx: &Context, i: usize, k: usize, seed: u64, unassigned: &AtomicU64) -> Vec<u32> {
+    let n = ctx.samplers.len();
+    let mut counts = vec![0u32; n];
+    let mut lost = 0;
+    for (origin, dir) in rays(ctx, i, k, seed) {
         let Some(hit) = ctx.vis.closest_hit(origin, dir) else {
             continue;
         };
