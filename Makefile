@@ -28,6 +28,7 @@ demo: build
 	$(BAKE) run pipelines/puget-sound-2k.ron --out out/demo/puget-sound-2k
 	$(BAKE) inspect out/demo/cornell
 	$(BAKE) export out/demo/cornell patches --out out/demo/cornell-patches.json
+	$(BAKE) export out/demo/cornell gltf --sun 20,30 --out out/demo/cornell-lit.glb
 	$(BAKE) inspect out/demo/puget-sound
 	$(BAKE) shadow pipelines/puget-sound.ron --sun-azimuth 300 --sun-elevation 10 \
 	    --out out/demo/puget-sound-shadow.png --shaded out/demo/puget-sound-relief.png
@@ -54,6 +55,7 @@ demo: build
 	@echo "demo output is in out/demo/:"
 	@echo "  cornell/, puget-sound/, puget-sound-2k/        baked directories (relume-bake inspect DIR)"
 	@echo "  cornell-patches.json                           the Cornell box's patches"
+	@echo "  cornell-lit.glb                                the Cornell box with its baked light and a sun, as glTF (any viewer)"
 	@echo "  puget-sound-shadow.png, puget-sound-relief.png hard shadows (CPU, 4K, sun 300°/10°)"
 	@echo "  puget-sound-lit.png, puget-sound-soft-relief.png  soft shadows (CPU, 4K, sun 300°/3°)"
 	@echo "  cornell-frames/frame_0000.png                  player: the Cornell box lit by its ceiling light"

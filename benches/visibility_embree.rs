@@ -1,0 +1,161 @@
+//! relume's tracer against Embree 4 (`embreex` on PyPI, a cross-check tool) on the same rays:
+//! the exact hemisphere rays the form-factor stage casts (`hemisphere::rays`), written with the
+//! triangles to `.npy`, traced by both in the same run. Closest hit and occlusion (to the
+//! closest hit's distance, so every occluded ray is also a hit for Embree), 1 and 2 threads,
+//! Mrays/s. Scenes: the Cornell box (32 triangles), random soups of 10,000 and 50,000
+//! triangles (the ≥ 50k-triangle scene; a furnished room is not bundled yet).
+//!
+//! `cargo bench --bench visibility_embree` (needs python3 with numpy and embreex: `make deps`).
+//! embreex's `scene.run` is single-threaded Embree behind a Python call: its rate includes
+//! copying the rays in and the results out, which is small against tracing at these counts.
+
+use rayon::prelude::*;
+use relume::radiosity::formfactor::{hemisphere, Context};
+use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::scene::Scene;
+use std::path::Path;
+use std::time::Instant;
+
+const EMBREE: &str = r#"
+import sys, time, numpy as np
+from embreex import rtcore_scene as rtcs
+from embreex.mesh_construction import TriangleMesh
+d = sys.argv[1]
+tris = np.load(d + '/tris.npy'); o = np.load(d + '/origins.npy'); v = np.load(d + '/dirs.npy')
+scene = rtcs.EmbreeScene(); TriangleMesh(scene=scene, vertices=tris)
+scene.run(o[:1000], v[:1000], output=1)  # warm-up
+best = 1e30
+for _ in range(3):
+    t = time.perf_counter(); r = scene.run(o, v, output=1); best = min(best, time.perf_counter() - t)
+tfar = np.where(r['primID'] >= 0, r['tfar'], 1e30).astype(np.float32)
+occ = 1e30
+for _ in range(3):
+    t = time.perf_counter(); scene.run(o, v, dists=np.minimum(tfar, 1e30), query='OCCLUDED'); occ = min(occ, time.perf_counter() - t)
+print(len(o) / best / 1e6, len(o) / occ / 1e6, int((r['primID'] >= 0).sum()))
+"#;
+
+fn rays_of(scene: &Scene, target: u32, k: usize) -> (Context, Vec<(glam::DVec3, glam::DVec3)>) {
+    let set = voxelize(
+        scene,
+        &VoxelizeParams {
+            resolution: Resolution::TargetPatches(target),
+            samples_per_patch: 1,
+        },
+    )
+    .unwrap();
+    let ctx = Context::new(scene, &set);
+    let rays = (0..set.len())
+        .flat_map(|i| hemisphere::rays(&ctx, i, k, 3))
+        .collect();
+    (ctx, rays)
+}
+
+/// Best of three wall times of `f` in a pool of `threads`.
+fn timed(threads: usize, f: impl Fn() + Sync + Send) -> f64 {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    (0..3)
+        .map(|_| {
+            let t = Instant::now();
+            pool.install(&f);
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn main() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tmp = std::env::temp_dir().join(format!("relume-embree-bench-{}", std::process::id()));
+    let (cornell, _) = relume::scene::load_scene(
+        &root.join("scenes/cornell-box/cornell_box.obj"),
+        relume::scene::SceneOptions { scale: 0.001 },
+    )
+    .unwrap();
+    let scenes = [
+        ("Cornell box", cornell, 1024u32),
+        (
+            "soup 10k",
+            relume::radiosity::fixtures::random_soup(10_000, 5),
+            4000,
+        ),
+        (
+            "soup 50k",
+            relume::radiosity::fixtures::random_soup(50_000, 6),
+            4000,
+        ),
+    ];
+    println!("Hemisphere rays of the form-factor stage, 64 per patch; best of 3; Mrays/s\n");
+    println!("| scene | triangles | rays | hits | relume closest 1 / 2 threads | Embree closest 1 thread | relume occlusion 1 / 2 threads | Embree occlusion 1 thread | relume / Embree per core (closest, occlusion) |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for (name, scene, target) in scenes {
+        let (ctx, rays) = rays_of(&scene, target, 64);
+        let dir = tmp.join(name.replace(' ', "-"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (_, tris): (Vec<u32>, Vec<[[f32; 3]; 3]>) = ctx.vis.triangles().unzip();
+        let flat: Vec<f32> = tris.iter().flatten().flatten().copied().collect();
+        let w = |f: &str, shape: &[u64], v: &[f32]| {
+            relume::baked::npy::write_npy_f32(&dir.join(f), shape, v).unwrap()
+        };
+        w("tris.npy", &[tris.len() as u64, 3, 3], &flat);
+        let n = rays.len() as u64;
+        let o: Vec<f32> = rays
+            .iter()
+            .flat_map(|(o, _)| o.as_vec3().to_array())
+            .collect();
+        let d: Vec<f32> = rays
+            .iter()
+            .flat_map(|(_, d)| d.as_vec3().to_array())
+            .collect();
+        w("origins.npy", &[n, 3], &o);
+        w("dirs.npy", &[n, 3], &d);
+        let hits: Vec<Option<f32>> = rays
+            .par_iter()
+            .map(|(o, d)| ctx.vis.closest_hit(*o, *d).map(|h| h.t))
+            .collect();
+        let hit_count = hits.iter().flatten().count();
+        let closest = |threads| {
+            let secs = timed(threads, || {
+                rays.par_iter().for_each(|(o, d)| {
+                    std::hint::black_box(ctx.vis.closest_hit(*o, *d));
+                })
+            });
+            rays.len() as f64 / secs / 1e6
+        };
+        let occlusion = |threads| {
+            let secs = timed(threads, || {
+                rays.par_iter().zip(&hits).for_each(|((o, d), h)| {
+                    let end = *o + *d * h.map_or(1e3, |t| t as f64);
+                    std::hint::black_box(ctx.vis.occluded(*o, end));
+                })
+            });
+            rays.len() as f64 / secs / 1e6
+        };
+        let (c1, c2, o1, o2) = (closest(1), closest(2), occlusion(1), occlusion(2));
+        let out = std::process::Command::new("python3")
+            .args(["-c", EMBREE, dir.to_str().unwrap()])
+            .output();
+        let embree: Vec<f64> = match out {
+            Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout)
+                .split_whitespace()
+                .filter_map(|x| x.parse().ok())
+                .collect(),
+            _ => Vec::new(),
+        };
+        let (ec, eo) = match embree.as_slice() {
+            [c, o, _] => (*c, *o),
+            _ => {
+                println!("| {name} | (embreex not available: `make deps-py`) |");
+                continue;
+            }
+        };
+        println!(
+            "| {name} | {} | {n} | {hit_count} | {c1:.2} / {c2:.2} | {ec:.2} | {o1:.2} / {o2:.2} | {eo:.2} | {:.2}x, {:.2}x |",
+            tris.len(),
+            c1 / ec,
+            o1 / eo
+        );
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
