@@ -9,10 +9,11 @@
 //! embreex's `scene.run` is single-threaded Embree behind a Python call: its rate includes
 //! copying the rays in and the results out, which is small against tracing at these counts.
 
+#[path = "../tests/support/embree_rays.rs"]
+mod embree_rays;
+
+use embree_rays::{hemisphere_rays, write_for_embree};
 use rayon::prelude::*;
-use relume::radiosity::formfactor::{hemisphere, Context};
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
-use relume::scene::Scene;
 use std::path::Path;
 use std::time::Instant;
 
@@ -33,22 +34,6 @@ for _ in range(3):
     t = time.perf_counter(); scene.run(o, v, dists=np.minimum(tfar, 1e30), query='OCCLUDED'); occ = min(occ, time.perf_counter() - t)
 print(len(o) / best / 1e6, len(o) / occ / 1e6, int((r['primID'] >= 0).sum()))
 "#;
-
-fn rays_of(scene: &Scene, target: u32, k: usize) -> (Context, Vec<(glam::DVec3, glam::DVec3)>) {
-    let set = voxelize(
-        scene,
-        &VoxelizeParams {
-            resolution: Resolution::TargetPatches(target),
-            samples_per_patch: 1,
-        },
-    )
-    .unwrap();
-    let ctx = Context::new(scene, &set);
-    let rays = (0..set.len())
-        .flat_map(|i| hemisphere::rays(&ctx, i, k, 3))
-        .collect();
-    (ctx, rays)
-}
 
 /// Best of three wall times of `f` in a pool of `threads`.
 fn timed(threads: usize, f: impl Fn() + Sync + Send) -> f64 {
@@ -90,26 +75,11 @@ fn main() {
     println!("| scene | triangles | rays | hits | relume closest 1 / 2 threads | Embree closest 1 thread | relume occlusion 1 / 2 threads | Embree occlusion 1 thread | relume / Embree per core (closest, occlusion) |");
     println!("|---|---|---|---|---|---|---|---|---|");
     for (name, scene, target) in scenes {
-        let (ctx, rays) = rays_of(&scene, target, 64);
+        let (ctx, rays) = hemisphere_rays(&scene, target, 64, 3);
         let dir = tmp.join(name.replace(' ', "-"));
         std::fs::create_dir_all(&dir).unwrap();
-        let (_, tris): (Vec<u32>, Vec<[[f32; 3]; 3]>) = ctx.vis.triangles().unzip();
-        let flat: Vec<f32> = tris.iter().flatten().flatten().copied().collect();
-        let w = |f: &str, shape: &[u64], v: &[f32]| {
-            relume::baked::npy::write_npy_f32(&dir.join(f), shape, v).unwrap()
-        };
-        w("tris.npy", &[tris.len() as u64, 3, 3], &flat);
+        let (_, tris) = write_for_embree(&dir, &ctx, &rays);
         let n = rays.len() as u64;
-        let o: Vec<f32> = rays
-            .iter()
-            .flat_map(|(o, _)| o.as_vec3().to_array())
-            .collect();
-        let d: Vec<f32> = rays
-            .iter()
-            .flat_map(|(_, d)| d.as_vec3().to_array())
-            .collect();
-        w("origins.npy", &[n, 3], &o);
-        w("dirs.npy", &[n, 3], &d);
         let hits: Vec<Option<f32>> = rays
             .par_iter()
             .map(|(o, d)| ctx.vis.closest_hit(*o, *d).map(|h| h.t))

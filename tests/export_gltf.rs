@@ -91,8 +91,8 @@ for node in doc['nodes']:
     summary['triangles'] += len(idx) // 3
     summary['lo'] = np.minimum(summary['lo'], pos.min(axis=0)).tolist()
     summary['hi'] = np.maximum(summary['hi'], pos.max(axis=0)).tolist()
-    out[node['name']] = rad.astype(float).tolist()
-if sys.argv[2] == 'radiance':
+    out[node['name']] = (pos if sys.argv[2] == 'positions' else rad).astype(float).tolist()
+if sys.argv[2] in ('radiance', 'positions'):
     print(json.dumps(out))
 else:
     # The OBJ's own vertices, parsed here: the export spans exactly their box.
@@ -225,13 +225,7 @@ fn baked_light_obeys_its_laws() {
     let ratio = |v: &[f64; 3], d: &[f64; 3]| (v[0] - d[0]) / (v[1] - d[1]).max(1e-9);
     let floor = &base["floor"];
     let fd = &direct["floor"];
-    let pos = python(
-        &READ_GLB.replace(
-            "out[node['name']] = rad.astype(float).tolist()",
-            "out[node['name']] = pos.astype(float).tolist()",
-        ),
-        &[s(&tmp.path().join("base.glb")), "radiance"],
-    );
+    let pos = python(READ_GLB, &[s(&tmp.path().join("base.glb")), "positions"]);
     let pos: std::collections::BTreeMap<String, Vec<[f64; 3]>> =
         serde_json::from_str(&pos).unwrap();
     let (mut near_red, mut near_green) = (Vec::new(), Vec::new());

@@ -9,11 +9,13 @@
 
 mod common;
 
+#[path = "support/embree_rays.rs"]
+mod embree_rays;
+
 use common::{python, repo, require_python};
+use embree_rays::{hemisphere_rays, write_for_embree};
 use glam::Vec3;
-use relume::radiosity::formfactor::{hemisphere, Context};
 use relume::radiosity::visibility::BACKOFF;
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 use std::path::Path;
 
@@ -33,44 +35,17 @@ t = np.where(prim >= 0, r['tfar'], -1.0).astype(np.float64)
 np.save(d + '/embree.npy', np.stack([prim.astype(np.float64), t], axis=1))
 "#;
 
-fn write_npy_f32(path: &Path, shape: &[u64], data: &[f32]) {
-    relume::baked::npy::write_npy_f32(path, shape, data).unwrap();
-}
-
 /// Trace the hemisphere rays of every patch of `scene` (`k` per patch) with relume and Embree;
 /// returns (rays, hits, disagreements).
 fn compare(scene: &Scene, target: u32, k: usize, dir: &Path) -> (usize, usize, usize) {
-    let set = voxelize(
-        scene,
-        &VoxelizeParams {
-            resolution: Resolution::TargetPatches(target),
-            samples_per_patch: 1,
-        },
-    )
-    .unwrap();
-    let ctx = Context::new(scene, &set);
-    let rays: Vec<_> = (0..set.len())
-        .flat_map(|i| hemisphere::rays(&ctx, i, k, 7))
-        .collect();
-    let (ids, tris): (Vec<u32>, Vec<[[f32; 3]; 3]>) = ctx.vis.triangles().unzip();
-    let flat: Vec<f32> = tris.iter().flatten().flatten().copied().collect();
-    write_npy_f32(&dir.join("tris.npy"), &[tris.len() as u64, 3, 3], &flat);
-    // Embree gets the ray from the origin in f32. relume starts its f32 ray BACKOFF behind the
-    // origin (obvhs's near-hit cut-off, src/radiosity/visibility.rs), rounded separately: the
-    // two starts differ by up to an f32 ulp of the coordinates, which moves a hit along the
-    // ray by that over |cos θ| (θ between the ray and the triangle's normal). Embree has no
-    // near limit to give it the same start without it hitting the surface the ray leaves.
-    let o: Vec<f32> = rays
-        .iter()
-        .flat_map(|(o, _)| o.as_vec3().to_array())
-        .collect();
-    let d: Vec<f32> = rays
-        .iter()
-        .flat_map(|(_, d)| d.as_vec3().to_array())
-        .collect();
+    let (ctx, rays) = hemisphere_rays(scene, target, k, 7);
+    // relume starts its f32 ray BACKOFF behind the origin (obvhs's near-hit cut-off,
+    // src/radiosity/visibility.rs), rounded separately from the f32 origin Embree gets: the two
+    // starts differ by up to an f32 ulp of the coordinates, which moves a hit along the ray by
+    // that over |cos θ| (θ between the ray and the triangle's normal). Embree has no near limit
+    // to give it the same start without it hitting the surface the ray leaves.
+    let (ids, tris) = write_for_embree(dir, &ctx, &rays);
     let n = rays.len() as u64;
-    write_npy_f32(&dir.join("origins.npy"), &[n, 3], &o);
-    write_npy_f32(&dir.join("dirs.npy"), &[n, 3], &d);
     python(EMBREE, &[dir.to_str().unwrap()]);
     let (shape, embree) = {
         // numpy wrote f64: read the raw little-endian values past the header.

@@ -100,8 +100,7 @@ pub fn export(dir: &Path, what: ExportWhat, out: &Path) -> Result<&'static str> 
                 .map_err(|e| Error::Internal(format!("cannot encode JSON: {e}")))?;
             std::fs::write(out, text).map_err(|e| Error::io(out, "cannot write", e))?;
         }
-        ExportWhat::Gltf => unreachable!("exported above"),
-        ExportWhat::FormFactors | ExportWhat::Transport => {
+        _ => {
             let (shape, values) = super::npy::read_npy_f32(&src)?;
             super::npy::write_npy_f32(out, &shape, &values)?;
         }

@@ -24,7 +24,7 @@
 use crate::error::{Error, Result};
 use crate::render::direct::{corner_indirect, gather_dense, patch_exitance};
 use crate::render::lights::{sun_light, GpuLight};
-use crate::render::mesh_reference::{corner_vertices, shade_point, FrameSettings};
+use crate::render::mesh_reference::{shade_point, FrameSettings};
 use crate::render::raycast::RaycastScene;
 use crate::scene::{Light, Scene};
 use crate::terrain::sun::Sun;
@@ -114,7 +114,7 @@ pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitRe
     };
     let indirect = corner_indirect(&set, &b);
     // Shading data per corner as the player draws it (emitters lifted off their wall).
-    let verts = corner_vertices(&scene);
+    let verts = rs.corner_data();
     let visible = rs.visible(&gpu_lights);
     let shade = |t: usize, w: [f32; 3]| -> [f32; 3] {
         let at = |k: usize, f: usize| Vec3::from_slice(&verts[12 * (3 * t + k) + f..][..3]);

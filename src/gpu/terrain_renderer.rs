@@ -65,12 +65,12 @@ pub struct TerrainFrame {
 }
 
 /// The horizon maps on the GPU: all planes stay on the CPU; the two around the sun's azimuth
-/// are packed per texel into one storage buffer, uploaded again only when the sun's azimuth
-/// leaves their bracket (a sun moving in elevation, or within the bracket, costs nothing).
+/// are packed per texel into `TerrainBuffers::horizon_pair`, uploaded again only when the
+/// sun's azimuth leaves their bracket (a sun moving in elevation, or within the bracket, costs
+/// nothing).
 struct HorizonGpu {
     map: HorizonMap,
-    buffer: wgpu::Buffer,
-    /// The planes in `buffer`.
+    /// The planes in `horizon_pair`.
     pair: Option<(usize, usize)>,
 }
 
@@ -300,11 +300,10 @@ impl TerrainRenderer {
                 "horizon map and height map sizes differ".into(),
             ));
         }
-        let buffer = compute::output(gpu, "horizon pair", (hm.width * hm.height * 4) as u64);
-        self.buffers.horizon_pair = buffer.clone();
+        self.buffers.horizon_pair =
+            compute::output(gpu, "horizon pair", (hm.width * hm.height * 4) as u64);
         self.horizon = Some(HorizonGpu {
             map: hm,
-            buffer,
             pair: None,
         });
         self.mask_groups[1] = self
@@ -334,7 +333,7 @@ impl TerrainRenderer {
         if h.pair != Some((k0, k1)) {
             let packed = h.map.packed_pair(k0, k1);
             gpu.queue
-                .write_buffer(&h.buffer, 0, bytemuck::cast_slice(&packed));
+                .write_buffer(&self.buffers.horizon_pair, 0, bytemuck::cast_slice(&packed));
             h.pair = Some((k0, k1));
         }
     }

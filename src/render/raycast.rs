@@ -53,6 +53,12 @@ impl RaycastScene {
         RaycastScene { verts, vis, extent }
     }
 
+    /// Per-corner vertex data the scene was built from ([`corner_vertices`]: 12 floats per
+    /// corner, emitters lifted).
+    pub fn corner_data(&self) -> &[f32] {
+        &self.verts
+    }
+
     /// Whether light `l` of `lights` reaches point `p` (normal `n`, unit vector `to_light`,
     /// distance `dist`): a shadow ray through the BVH from `p` lifted by the BVH's epsilon along
     /// `n` (the closure [`shade_point`] and [`super::direct::patch_exitance`] take).

@@ -138,6 +138,17 @@ impl HorizonMap {
     /// Hard shadows for any sun in O(1) per pixel: shadowed when the elevation is below the
     /// horizon interpolated between the two stored azimuths around the sun's.
     pub fn shadow_mask(&self, sun: &super::sun::Sun) -> Vec<bool> {
+        self.mask(sun, |v0, v1, w| sun.elevation_deg < horizon_at(v0, v1, w))
+    }
+
+    /// Every texel's test `shadowed(v0, v1, w)` on the two planes around the sun's azimuth
+    /// (lit at the zenith, shadowed at or below the horizon: the cases of
+    /// [`super::sun::TrackKind`], which the GPU decides the same way).
+    fn mask(
+        &self,
+        sun: &super::sun::Sun,
+        shadowed: impl Fn(u16, u16, f64) -> bool + Sync,
+    ) -> Vec<bool> {
         let n = self.width * self.height;
         if sun.elevation_deg >= 90.0 {
             return vec![false; n];
@@ -149,7 +160,7 @@ impl HorizonMap {
         let (p0, p1) = (&self.angles[k0], &self.angles[k1]);
         (0..n)
             .into_par_iter()
-            .map(|i| sun.elevation_deg < horizon_at(p0[i], p1[i], w))
+            .map(|i| shadowed(p0[i], p1[i], w))
             .collect()
     }
 
@@ -166,20 +177,8 @@ impl HorizonMap {
     /// The GPU's horizon mask (`shadowed_horizon` in `shaders/terrain_shadow.wgsl`), its f32
     /// twin: the bracket and weight in f64 as the renderer computes them, the test in f32.
     pub fn shadow_mask_f32(&self, sun: &super::sun::Sun) -> Vec<bool> {
-        let n = self.width * self.height;
-        let track = super::sun::Track::new(sun, [1.0, 1.0]);
-        match track.kind {
-            super::sun::TrackKind::Zenith => return vec![false; n],
-            super::sun::TrackKind::BelowHorizon => return vec![true; n],
-            super::sun::TrackKind::Ray => {}
-        }
-        let (k0, k1, w) = self.bracket(sun.azimuth_deg);
-        let (p0, p1) = (&self.angles[k0], &self.angles[k1]);
         let e = sun.elevation_deg as f32;
-        (0..n)
-            .into_par_iter()
-            .map(|i| shadowed_f32(p0[i], p1[i], w as f32, e))
-            .collect()
+        self.mask(sun, |v0, v1, w| shadowed_f32(v0, v1, w as f32, e))
     }
 
     /// The sky-view factor of a horizontal surface: the part of the sky hemisphere's
