@@ -16,6 +16,9 @@ pub enum ExportWhat {
     Transport,
     /// The scene with its baked lighting for a light setup, binary glTF ([`super::gltf`]).
     Gltf,
+    /// Mean irradiance per scene object for a light setup, JSON
+    /// ([`crate::radiosity::objects`]).
+    Objects,
 }
 
 /// A standard light configuration of the encode report (`compress::report::standard_lights`).
@@ -58,6 +61,10 @@ pub fn export(dir: &Path, what: ExportWhat, out: &Path) -> Result<&'static str> 
         ExportWhat::Gltf => {
             super::gltf::export_lit_glb(dir, &Default::default(), out)?;
             return Ok("gltf");
+        }
+        ExportWhat::Objects => {
+            export_objects(dir, &Default::default(), out)?;
+            return Ok("objects");
         }
     };
     if manifest.file(file).is_none() {
@@ -106,6 +113,26 @@ pub fn export(dir: &Path, what: ExportWhat, out: &Path) -> Result<&'static str> 
         }
     }
     Ok(file)
+}
+
+/// Per-object light of the bake in `dir` under `setup`, as JSON at `out`: for every scene
+/// object its area and mean irradiance (corner-interpolated and from the patches) from light
+/// that was reflected at least once or comes from an emitter — the punctual lights' direct
+/// light is left out (the player evaluates it per pixel).
+pub fn export_objects(
+    dir: &Path,
+    setup: &super::gltf::LitExport,
+    out: &Path,
+) -> Result<Vec<crate::radiosity::objects::ObjectLight>> {
+    let lit = super::gltf::lit_patches(dir, setup)?;
+    let objects = crate::radiosity::objects::object_light(&lit.scene, &lit.set, &lit.b);
+    let doc = serde_json::json!({ "transport": lit.transport, "objects": objects });
+    let text = serde_json::to_string_pretty(&doc)
+        .map_err(|e| Error::Internal(format!("cannot encode JSON: {e}")))?;
+    super::images::write_atomic(out, |tmp| {
+        std::fs::write(tmp, text).map_err(|e| Error::io(tmp, "cannot write", e))
+    })?;
+    Ok(objects)
 }
 
 /// Gather `B_ind = S·E` from the compressed transport of the bake in `dir` for a standard light

@@ -71,14 +71,29 @@ pub struct LitReport {
     pub clamped_fraction: f64,
 }
 
-/// Export the bake in `dir` lit by `setup` to `out` (`.glb`).
-pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitReport> {
+/// A bake lit by a light setup: per-patch indirect exitance `b = S·E` (E: the direct exitance
+/// of the setup's lights at the patches' sample points, plus emission).
+pub struct LitPatches {
+    pub scene: Scene,
+    pub set: crate::radiosity::PatchSet,
+    /// The scene's lights, the setup's, and its sun.
+    pub lights: Vec<Light>,
+    pub gpu_lights: Vec<GpuLight>,
+    pub raycast: RaycastScene,
+    pub b: Vec<[f32; 3]>,
+    /// Which transport gave `b`: "dense", "encoded" or none.
+    pub transport: &'static str,
+}
+
+/// Light the bake in `dir` with `setup`: read the scene, the patches and the transport, and
+/// gather `b = S·E`.
+pub fn lit_patches(dir: &Path, setup: &LitExport) -> Result<LitPatches> {
     let manifest = super::Manifest::read(dir)?;
     for need in [super::scene::FILE, super::patches::FILE] {
         if manifest.file(need).is_none() {
             return Err(Error::input(
                 dir,
-                format!("this bake has no `{need}`: glTF export needs a scene bake with `Voxelize` (see `relume-bake inspect`)"),
+                format!("this bake has no `{need}`: lighting it needs a scene bake with `Voxelize` (see `relume-bake inspect`)"),
             ));
         }
     }
@@ -92,8 +107,8 @@ pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitRe
         .map(|l| GpuLight::from_light(l, 1.0, 0))
         .collect();
     let s = &setup.settings;
-    let rs = RaycastScene::new(&scene);
-    let e = patch_exitance(&set, &gpu_lights, s, &rs.visible(&gpu_lights));
+    let raycast = RaycastScene::new(&scene);
+    let e = patch_exitance(&set, &gpu_lights, s, &raycast.visible(&gpu_lights));
     let n = set.patches.len();
     let (b, transport) = if manifest.file(super::transport::FILE).is_some() {
         let m = super::transport::read(dir)?;
@@ -112,6 +127,29 @@ pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitRe
     } else {
         (vec![[0.0; 3]; n], "none (direct light only)")
     };
+    Ok(LitPatches {
+        scene,
+        set,
+        lights,
+        gpu_lights,
+        raycast,
+        b,
+        transport,
+    })
+}
+
+/// Export the bake in `dir` lit by `setup` to `out` (`.glb`).
+pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitReport> {
+    let LitPatches {
+        scene,
+        set,
+        lights,
+        gpu_lights,
+        raycast: rs,
+        b,
+        transport,
+    } = lit_patches(dir, setup)?;
+    let s = &setup.settings;
     let indirect = corner_indirect(&set, &b);
     // Shading data per corner as the player draws it (emitters lifted off their wall).
     let verts = rs.corner_data();

@@ -2,73 +2,11 @@
 //! of [`super::formfactor::analytic`], closed boxes (furnace tests) and two rooms separated by a
 //! thin wall (the transfer's leak test).
 
-use crate::scene::{Material, Scene};
+pub use crate::scene::builder::SceneBuilder;
+use crate::scene::Scene;
 use glam::DVec3;
 
-/// Builds a [`Scene`] from quads and polygons.
-#[derive(Default)]
-pub struct SceneBuilder {
-    scene: Scene,
-}
-
 impl SceneBuilder {
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Add a material; returns its index.
-    pub fn material(&mut self, name: &str, albedo: [f32; 3], emission: [f32; 3]) -> u32 {
-        self.scene.materials.push(Material {
-            name: name.into(),
-            albedo,
-            emission,
-        });
-        (self.scene.materials.len() - 1) as u32
-    }
-
-    fn object(&mut self, name: &str) -> u32 {
-        match self.scene.objects.iter().position(|o| o == name) {
-            Some(i) => i as u32,
-            None => {
-                self.scene.objects.push(name.into());
-                (self.scene.objects.len() - 1) as u32
-            }
-        }
-    }
-
-    /// A triangle (counter-clockwise front face).
-    pub fn triangle(&mut self, object: &str, corners: [DVec3; 3], material: u32) {
-        let o = self.object(object);
-        let base = self.scene.positions.len() as u32;
-        for c in corners {
-            self.scene.positions.push(c.as_vec3().to_array());
-        }
-        self.scene.triangles.push([base, base + 1, base + 2]);
-        self.scene.triangle_material.push(material);
-        self.scene.triangle_object.push(o);
-    }
-
-    /// A convex polygon as a triangle fan (counter-clockwise about its front normal).
-    pub fn polygon(&mut self, object: &str, corners: &[DVec3], material: u32) {
-        for i in 1..corners.len() - 1 {
-            self.triangle(object, [corners[0], corners[i], corners[i + 1]], material);
-        }
-    }
-
-    /// The rectangle `centre ± u ± v` facing `u × v`.
-    pub fn rectangle(&mut self, object: &str, centre: DVec3, u: DVec3, v: DVec3, material: u32) {
-        self.polygon(
-            object,
-            &[
-                centre - u - v,
-                centre + u - v,
-                centre + u + v,
-                centre - u + v,
-            ],
-            material,
-        );
-    }
-
     /// A regular `segments`-gon of circumradius `r` at `centre` facing `normal`.
     pub fn disc(
         &mut self,
@@ -88,24 +26,6 @@ impl SceneBuilder {
             })
             .collect();
         self.polygon(object, &pts, material);
-    }
-
-    /// The six inward-facing faces of the box `[lo, hi]`.
-    pub fn box_inside(&mut self, object: &str, lo: DVec3, hi: DVec3, material: u32) {
-        let c = (lo + hi) / 2.0;
-        let h = (hi - lo) / 2.0;
-        let (x, y, z) = (DVec3::X * h.x, DVec3::Y * h.y, DVec3::Z * h.z);
-        // Each face's u × v points into the box.
-        self.rectangle(object, c - x, y, z, material); // normal +x... y × z = +x
-        self.rectangle(object, c + x, z, y, material); // z × y = −x
-        self.rectangle(object, c - y, z, x, material); // z × x = +y
-        self.rectangle(object, c + y, x, z, material); // x × z = −y
-        self.rectangle(object, c - z, x, y, material); // x × y = +z
-        self.rectangle(object, c + z, y, x, material); // y × x = −z
-    }
-
-    pub fn build(self) -> Scene {
-        self.scene
     }
 }
 

@@ -22,6 +22,7 @@ pub mod geometry;
 pub mod infinite;
 pub mod locate;
 pub mod matrix;
+pub mod objects;
 pub mod overlap;
 pub mod reference;
 pub mod transport;

@@ -6,9 +6,12 @@
 //! multiplied by the pipeline's `scale` knob (the bundled Cornell box is in millimetres);
 //! front faces wind counter-clockwise; emission is radiance L (W·m⁻²·sr⁻¹, OBJ `Ke`).
 
+pub mod builder;
 pub mod freeform;
+pub mod generate;
 mod gltf_loader;
 mod obj_loader;
+pub mod obj_writer;
 pub mod punctual;
 pub mod shape_texture;
 

@@ -16,13 +16,24 @@ use relume::radiosity::formfactor::Estimator;
 use relume::radiosity::transport::{Bounces, Power};
 use relume::radiosity::voxelize::Resolution;
 use relume::render::mesh_reference::FrameSettings;
+use relume::scene::generate::{generate, Generated};
 use relume::scene::Light;
 use relume::Result;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Each `Option` flag falls back to the pipeline default of its knob (`pipeline::knobs`).
 #[derive(Subcommand)]
 pub enum Command {
+    /// Write one of the indoor scenes relume makes itself (OBJ + MTL beside it): the bundled
+    /// copies in scenes/generated/ are this output
+    GenerateScene {
+        /// Which scene
+        #[arg(value_enum)]
+        scene: Generated,
+        /// Output .obj file; the .mtl is written beside it with the same stem
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+    },
     /// Run the `voxelize` stage alone on a baked directory (later stages are dropped)
     Voxelize {
         /// Baked directory of a scene
@@ -68,9 +79,9 @@ pub enum Command {
         #[command(flatten)]
         budget: Budget,
     },
-    /// Export patches as JSON, the form-factor / transport matrix as .npy, or the scene with
-    /// its baked light as binary glTF (gltf: per-vertex radiance for the scene's lights and
-    /// emitters plus --light / --sun)
+    /// Export patches as JSON, the form-factor / transport matrix as .npy, the scene with its
+    /// baked light as binary glTF (gltf: per-vertex radiance for the scene's lights and
+    /// emitters plus --light / --sun), or the mean irradiance per scene object (objects: JSON)
     Export {
         /// Baked directory
         baked_dir: PathBuf,
@@ -145,6 +156,7 @@ pub struct Budget {
 /// Run a radiosity subcommand.
 pub fn run(cmd: &Command, json: bool, quiet: bool, ui: &crate::ui::Ui) -> Result<i32> {
     let (dir, stage, budget) = match cmd {
+        Command::GenerateScene { scene, out } => return generate_scene(*scene, out, json, quiet),
         Command::Voxelize {
             baked_dir,
             target_patches,
@@ -215,9 +227,25 @@ pub fn run(cmd: &Command, json: bool, quiet: bool, ui: &crate::ui::Ui) -> Result
                 }
                 return Ok(exit::OK);
             }
+            if *what == ExportWhat::Objects {
+                let objects = relume::baked::export::export_objects(baked_dir, &lit.setup(), out)?;
+                if json {
+                    println!(
+                        "{}",
+                        serde_json::json!({"exported": "objects", "out": out, "objects": objects.len()})
+                    );
+                } else if !quiet {
+                    eprintln!(
+                        "wrote {}: light of {} objects",
+                        out.display(),
+                        objects.len()
+                    );
+                }
+                return Ok(exit::OK);
+            }
             if lit.given() {
                 return Err(relume::error::Error::knob(
-                    "--light, --sun, --exposure, --max-edge, --no-shadows and --no-indirect apply to `export gltf` only",
+                    "--light, --sun, --exposure, --max-edge, --no-shadows and --no-indirect apply to `export gltf` and `export objects` only",
                 ));
             }
             let file = relume::baked::export::export(baked_dir, *what, out)?;
@@ -233,5 +261,44 @@ pub fn run(cmd: &Command, json: bool, quiet: bool, ui: &crate::ui::Ui) -> Result
     }
     let report = run_stage_on_with(dir, stage, &opts, ui)?;
     crate::print_stage_report(&report, dir, json, quiet);
+    Ok(exit::OK)
+}
+
+fn generate_scene(which: Generated, out: &Path, json: bool, quiet: bool) -> Result<i32> {
+    relume::baked::images::check_extension(out, &["obj"])?;
+    let scene = generate(which);
+    let mtl_path = out.with_extension("mtl");
+    let mtl_name = mtl_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let header = format!(
+        "{}: made by `relume-bake generate-scene {} --out FILE.obj` (metres, y up).",
+        which.name(),
+        which.name()
+    );
+    let (obj, mtl) = relume::scene::obj_writer::to_obj(&scene, &mtl_name, &header);
+    for (path, text) in [(mtl_path.as_path(), &mtl), (out, &obj)] {
+        relume::baked::images::write_atomic(path, |tmp| {
+            std::fs::write(tmp, text).map_err(|e| relume::error::Error::io(path, "cannot write", e))
+        })?;
+    }
+    if json {
+        println!(
+            "{}",
+            serde_json::json!({"scene": which.name(), "out": out, "mtl": mtl_path,
+                "triangles": scene.triangles.len(), "vertices": scene.positions.len(),
+                "objects": scene.objects.len(), "area": scene.total_area()})
+        );
+    } else if !quiet {
+        eprintln!(
+            "{} → {} ({} triangles, {} objects, {:.1} m² of surface)",
+            which.name(),
+            out.display(),
+            scene.triangles.len(),
+            scene.objects.len(),
+            scene.total_area()
+        );
+    }
     Ok(exit::OK)
 }

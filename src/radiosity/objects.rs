@@ -1,0 +1,101 @@
+//! Light per scene object: the mean irradiance over each object's surface from per-patch
+//! exitance, two ways — through the per-corner interpolation (what the player and the glTF
+//! export show) and straight from the patches each triangle's visible area went into (the
+//! radiosity solution itself). This is the quantity a path tracer's irradiance meter measures
+//! on the same object, so it is how bakes are compared with Mitsuba (`tests/radiosity_rooms.rs`)
+//! and how the study reports per-object error.
+//!
+//! Irradiance H = B / ρ per triangle (B the reflected exitance, ρ the triangle's albedo; a
+//! channel with ρ = 0 reflects nothing and reports 0), averaged over the object by area.
+
+use super::PatchSet;
+use crate::scene::Scene;
+use serde::Serialize;
+
+/// One object's light.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectLight {
+    pub name: String,
+    /// Total triangle area (scene units²).
+    pub area: f64,
+    /// Mean irradiance from the corner interpolation, per channel.
+    pub irradiance: [f64; 3],
+    /// Mean irradiance from the patches (area-weighted over each triangle's visible pieces).
+    pub irradiance_patches: [f64; 3],
+    /// Largest patch irradiance touching the object (0 exactly when no light reaches it).
+    pub max_patch_irradiance: f64,
+}
+
+/// Per-object light of `scene` from per-patch reflected exitance `b` (`[n][3]`, e.g. `S·E`).
+/// `set` must be the voxelization of `scene`.
+pub fn object_light(scene: &Scene, set: &PatchSet, b: &[[f32; 3]]) -> Vec<ObjectLight> {
+    let mut out: Vec<ObjectLight> = scene
+        .objects
+        .iter()
+        .map(|name| ObjectLight {
+            name: name.clone(),
+            area: 0.0,
+            irradiance: [0.0; 3],
+            irradiance_patches: [0.0; 3],
+            max_patch_irradiance: 0.0,
+        })
+        .collect();
+    let mut visible_area = vec![0.0f64; out.len()];
+    for t in 0..scene.triangles.len() {
+        let o = &mut out[scene.triangle_object[t] as usize];
+        let rho = scene.materials[scene.triangle_material[t] as usize].albedo;
+        let inv = rho.map(|r| if r > 0.0 { 1.0 / r as f64 } else { 0.0 });
+        let area = scene.triangle_area(t) as f64;
+        o.area += area;
+        for k in 0..3 {
+            let (ps, ws) = set.corners.list(3 * t + k);
+            for (&p, &w) in ps.iter().zip(ws) {
+                for c in 0..3 {
+                    o.irradiance[c] += area / 3.0 * w as f64 * b[p as usize][c] as f64 * inv[c];
+                }
+            }
+        }
+        let (ps, areas) = set.triangle_patches.list(t);
+        for (&p, &a) in ps.iter().zip(areas) {
+            for c in 0..3 {
+                let h = b[p as usize][c] as f64 * inv[c];
+                o.irradiance_patches[c] += a as f64 * h;
+                o.max_patch_irradiance = o.max_patch_irradiance.max(h);
+            }
+            visible_area[scene.triangle_object[t] as usize] += a as f64;
+        }
+    }
+    for (o, &va) in out.iter_mut().zip(&visible_area) {
+        for c in 0..3 {
+            o.irradiance[c] /= o.area.max(f64::MIN_POSITIVE);
+            o.irradiance_patches[c] /= va.max(f64::MIN_POSITIVE);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::radiosity::fixtures;
+    use crate::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+
+    /// A constant B over every patch gives H = B / ρ on every object, both ways.
+    #[test]
+    fn constant_light_gives_b_over_albedo() {
+        let scene = fixtures::thin_wall_rooms(0.05);
+        let params = VoxelizeParams {
+            resolution: Resolution::VoxelSize(0.2),
+            samples_per_patch: 1,
+        };
+        let set = voxelize(&scene, &params).unwrap();
+        let b = vec![[0.35f32, 0.7, 0.07]; set.patches.len()];
+        for o in object_light(&scene, &set, &b) {
+            for c in 0..3 {
+                let want = b[0][c] as f64 / 0.7;
+                assert!((o.irradiance[c] / want - 1.0).abs() < 1e-5, "{o:?}");
+                assert!((o.irradiance_patches[c] / want - 1.0).abs() < 1e-5, "{o:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,94 @@
+//! The bundled real-size scenes (`scenes/generated/`, made by `relume-bake generate-scene`):
+//! they are exactly what the generator writes; behind a closed door the dark room receives no
+//! light at all; through a door ajar it receives what Mitsuba 3's path tracer says it does.
+
+mod common;
+use common::*;
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+const SCENES: [&str; 3] = ["furnished-room", "door-ajar", "door-sealed"];
+
+#[test]
+fn bundled_scenes_are_what_generate_scene_writes() {
+    let tmp = tempfile::tempdir().unwrap();
+    for name in SCENES {
+        let out = tmp.path().join(format!("{name}.obj"));
+        let o = bake(
+            tmp.path(),
+            &["generate-scene", name, "--out", out.to_str().unwrap()],
+        );
+        expect_code(&o, 0);
+        for ext in ["obj", "mtl"] {
+            let made = std::fs::read(out.with_extension(ext)).unwrap();
+            let bundled = std::fs::read(data(&format!("scenes/generated/{name}.{ext}"))).unwrap();
+            assert!(
+                made == bundled,
+                "scenes/generated/{name}.{ext} differs from `relume-bake generate-scene {name}`: regenerate it"
+            );
+        }
+    }
+}
+
+/// Bake a bundled pipeline into `dir` and return its per-object light by name.
+fn bake_objects(dir: &Path, pipeline: &str) -> BTreeMap<String, Value> {
+    let out = dir.join("bake");
+    let o = bake(
+        dir,
+        &[
+            "-q",
+            "run",
+            data(&format!("pipelines/{pipeline}.ron")).to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--no-cache",
+        ],
+    );
+    expect_code(&o, 0);
+    let json = dir.join("objects.json");
+    let o = bake(
+        dir,
+        &[
+            "export",
+            out.to_str().unwrap(),
+            "objects",
+            "--out",
+            json.to_str().unwrap(),
+        ],
+    );
+    expect_code(&o, 0);
+    let doc: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    doc["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| (o["name"].as_str().unwrap().to_string(), o.clone()))
+        .collect()
+}
+
+fn rgb(v: &Value) -> [f64; 3] {
+    std::array::from_fn(|c| v[c].as_f64().unwrap())
+}
+
+/// In the sealed variant every surface of the dark room (all but the door leaf, whose inner
+/// face fills the doorway on the bright side) gets exactly zero light: no patch spans the
+/// wall, no corner interpolates across it, no form-factor ray finds a crack.
+#[test]
+fn closed_door_keeps_the_dark_room_exactly_dark() {
+    let tmp = tempfile::tempdir().unwrap();
+    let objects = bake_objects(tmp.path(), "door-sealed");
+    let mut dark = 0;
+    for (name, o) in &objects {
+        let h = rgb(&o["irradiance"]);
+        if name.starts_with("dark.") && name != "dark.door" {
+            dark += 1;
+            assert_eq!(o["max_patch_irradiance"].as_f64(), Some(0.0), "{name}: {o}");
+            assert_eq!(h, [0.0; 3], "{name}: {o}");
+            assert_eq!(rgb(&o["irradiance_patches"]), [0.0; 3], "{name}: {o}");
+        } else {
+            assert!(h.iter().all(|&x| x > 0.1), "{name} should be lit: {o}");
+        }
+    }
+    assert_eq!(dark, 6);
+}
