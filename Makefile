@@ -6,7 +6,7 @@ BAKE     := target/release/relume-bake
 PLAYER   := target/release/relume-player
 SUDO     := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth gdal-bin
-PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder rasterio embreex
+PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder rasterio embreex mitsuba
 export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)

@@ -82,12 +82,19 @@ fn target_patches_lands_within_twenty_percent_or_says_why() {
     let soup = soup(tmp.path(), 10_000);
     let cornell = data("scenes/cornell-box/cornell_box.obj");
     let room = data("scenes/gltf-room/room.gltf");
+    let furnished = data("scenes/generated/furnished-room.obj");
+    let ajar = data("scenes/generated/door-ajar.obj");
+    let sealed = data("scenes/generated/door-sealed.obj");
     let mut k = 0;
     for (scene, target) in [
         (&cornell, 600),
         (&cornell, 4096),
         (&room, 300),
         (&room, 3000),
+        (&furnished, 1000),
+        (&furnished, 4000),
+        (&ajar, 2000),
+        (&sealed, 500),
         (&soup, 10_000),
         (&soup, 20_000),
     ] {

@@ -1,0 +1,79 @@
+//! Per-object irradiance of the bundled door-ajar scene against Mitsuba 3, by patch count:
+//! how close radiosity comes to a path tracer where light enters a room only through a gap.
+//!
+//! The reference is `tests/reference/door-ajar.mitsuba.json`, made by
+//! `python3 tests/support/mitsuba_objects.py scenes/generated/door-ajar.obj 1000000 6 dark. bright.`
+//! (6 × 1 M samples per object; its standard error is printed beside each object).
+//!
+//! Run: `cargo bench --bench rooms_mitsuba` (`PATCHES=1000,2000,4000,8000`, `SCENE=door-ajar`).
+
+#[path = "../tests/support/room_light.rs"]
+mod room_light;
+mod util;
+
+use std::time::Instant;
+
+fn main() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let name: String = util::env("SCENE", "door-ajar".to_string());
+    let targets: Vec<u32> = util::env_list("PATCHES", "1000,2000,4000,8000");
+    let scene = room_light::room(&name);
+    let reference: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(format!("{root}/tests/reference/{name}.mitsuba.json")).unwrap(),
+    )
+    .unwrap();
+    let objects: Vec<&String> = reference.as_object().unwrap().keys().collect();
+    println!(
+        "{name}: {} triangles; relume per-object irradiance (patches | corner-interpolated) vs \
+         Mitsuba, relative error, mean over RGB; {} threads\n",
+        scene.triangles.len(),
+        rayon::current_num_threads()
+    );
+    print!("| object | Mitsuba (rel. std. error) |");
+    for t in &targets {
+        print!(" {t} |");
+    }
+    println!();
+    let mut rows: Vec<String> = objects
+        .iter()
+        .map(|o| {
+            let r = &reference[o.as_str()];
+            let se: f64 = (0..3)
+                .map(|c| r["stderr"][c].as_f64().unwrap() / r["mean"][c].as_f64().unwrap())
+                .sum::<f64>()
+                / 3.0;
+            format!("| {o} | {:.2} % |", 100.0 * se)
+        })
+        .collect();
+    let mut summary = Vec::new();
+    for &target in &targets {
+        let t0 = Instant::now();
+        let (light, patches) = room_light::object_light_at(&scene, target);
+        let seconds = t0.elapsed().as_secs_f64();
+        let mut worst = (0f64, 0f64);
+        for (row, o) in rows.iter_mut().zip(&objects) {
+            let r = &reference[o.as_str()];
+            let got = light.iter().find(|l| &&l.name == o).unwrap();
+            let err = |v: [f64; 3]| room_light::relative_error(v, r).iter().sum::<f64>() / 3.0;
+            let (ep, ec) = (err(got.irradiance_patches), err(got.irradiance));
+            if o.starts_with("dark.") {
+                worst = (worst.0.max(ep.abs()), worst.1.max(ec.abs()));
+            }
+            row.push_str(&format!(" {:+.1} % / {:+.1} % |", 100.0 * ep, 100.0 * ec));
+        }
+        summary.push(format!(
+            "| {target} | {} | {:.1} s | {:.1} % | {:.1} % |",
+            patches,
+            seconds,
+            100.0 * worst.0,
+            100.0 * worst.1
+        ));
+    }
+    for row in rows {
+        println!("{row}");
+    }
+    println!("\n| target | patches | bake time | worst dark-room object, patches | corners |");
+    for s in summary {
+        println!("{s}");
+    }
+}
