@@ -1,5 +1,6 @@
 //! Headless frame times of the player, split by pass (GPU timestamp queries), for the Cornell
-//! box and Puget Sound 2K at 640x480 and 1920x1080. On Mesa's lavapipe/llvmpipe these "GPU"
+//! box, the furnished room (78k triangles, 4,000 patches) and Puget Sound 2K at 640x480 and
+//! 1920x1080 (`PIPELINES=furnished-room,cornell` runs some). On Mesa's lavapipe/llvmpipe these "GPU"
 //! times are CPU times of a software rasteriser, not GPU times.
 //!
 //! The terrain frame is one render pass with the relief shadows traced per pixel inside it: the
@@ -65,6 +66,13 @@ fn main() {
             ],
         ),
         (
+            "pipelines/furnished-room.ron",
+            vec![
+                ("emitters + sun, shadows", Shadows::Hard),
+                ("emitters + sun, no shadows", Shadows::None),
+            ],
+        ),
+        (
             "pipelines/puget-sound-2k.ron",
             vec![
                 ("no shadows", Shadows::None),
@@ -74,6 +82,12 @@ fn main() {
             ],
         ),
     ] {
+        let name = pipeline.trim_start_matches("pipelines/").trim_end_matches(".ron");
+        if let Ok(only) = std::env::var("PIPELINES") {
+            if !only.split(',').any(|o| o.trim() == name) {
+                continue;
+            }
+        }
         let mut p = parse_pipeline(&root.join(pipeline)).expect("pipeline");
         if p.input.kind() == "heightmap"
             && !p.stages.iter().any(|s| matches!(s, Stage::HorizonMaps(_)))
@@ -123,10 +137,7 @@ fn main() {
                     .map(|(n, v)| format!("{n} {:.1}", median(v)))
                     .collect();
                 println!(
-                    "| {} | {w}x{h} | {label} | {:.1} | {} |",
-                    pipeline
-                        .trim_start_matches("pipelines/")
-                        .trim_end_matches(".ron"),
+                    "| {name} | {w}x{h} | {label} | {:.1} | {} |",
                     median(wall),
                     per_pass.join(", ")
                 );

@@ -3,6 +3,7 @@
 
 use relume::heightmap::HeightMap;
 
+#[allow(unused_imports)]
 pub use relume::study::timing::cpu_seconds;
 
 /// The height map of a bundled pipeline (with its input knobs).
