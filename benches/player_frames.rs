@@ -82,7 +82,9 @@ fn main() {
             ],
         ),
     ] {
-        let name = pipeline.trim_start_matches("pipelines/").trim_end_matches(".ron");
+        let name = pipeline
+            .trim_start_matches("pipelines/")
+            .trim_end_matches(".ron");
         if let Ok(only) = std::env::var("PIPELINES") {
             if !only.split(',').any(|o| o.trim() == name) {
                 continue;

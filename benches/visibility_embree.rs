@@ -2,8 +2,8 @@
 //! the exact hemisphere rays the form-factor stage casts (`hemisphere::rays`), written with the
 //! triangles to `.npy`, traced by both in the same run. Closest hit and occlusion (to the
 //! closest hit's distance, so every occluded ray is also a hit for Embree), 1 and 2 threads,
-//! Mrays/s. Scenes: the Cornell box (32 triangles), random soups of 10,000 and 50,000
-//! triangles (the ≥ 50k-triangle scene; a furnished room is not bundled yet).
+//! Mrays/s. Scenes: the Cornell box (32 triangles), a random soup of 10,000 triangles and the
+//! bundled furnished room (78,324 triangles, `scenes/generated/furnished-room.obj`).
 //!
 //! `cargo bench --bench visibility_embree` (needs python3 with numpy and embreex: `make deps`).
 //! embreex's `scene.run` is single-threaded Embree behind a Python call: its rate includes
@@ -66,8 +66,13 @@ fn main() {
             4000,
         ),
         (
-            "soup 50k",
-            relume::radiosity::fixtures::random_soup(50_000, 6),
+            "furnished room",
+            relume::scene::load_scene(
+                &root.join("scenes/generated/furnished-room.obj"),
+                Default::default(),
+            )
+            .unwrap()
+            .0,
             4000,
         ),
     ];

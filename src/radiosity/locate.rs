@@ -24,6 +24,9 @@ pub struct PatchLocator {
     ranges: Vec<(usize, usize)>,
     /// Vertices and unit normal of each piece.
     pieces: Vec<(Vec<DVec3>, DVec3)>,
+    /// A bounding sphere (centre, radius) of each piece: `distance` skips a piece that cannot
+    /// come nearer than the best so far (a patch of a finely meshed statue holds hundreds).
+    spheres: Vec<(DVec3, f64)>,
     /// Dominant axis of each scene triangle.
     triangle_axis: Vec<u8>,
     /// Dense (first patch, count) per group key when the grid is small enough, else empty (then
@@ -46,7 +49,7 @@ impl PatchLocator {
             .iter()
             .map(|p| (p.first_piece as usize, p.piece_count as usize))
             .collect();
-        let pieces = set
+        let pieces: Vec<(Vec<DVec3>, DVec3)> = set
             .pieces
             .iter()
             .map(|p| {
@@ -54,6 +57,14 @@ impl PatchLocator {
                     p.vertices.iter().map(|&v| DVec3::from(v)).collect(),
                     DVec3::from(p.normal),
                 )
+            })
+            .collect();
+        let spheres = pieces
+            .iter()
+            .map(|(poly, _)| {
+                let c = poly.iter().sum::<DVec3>() / poly.len().max(1) as f64;
+                let r = poly.iter().map(|&v| (v - c).length()).fold(0.0, f64::max);
+                (c, r)
             })
             .collect();
         let triangle_axis = (0..scene.triangles.len())
@@ -79,6 +90,7 @@ impl PatchLocator {
             keys,
             ranges,
             pieces,
+            spheres,
             triangle_axis,
             table,
         }
@@ -106,13 +118,28 @@ impl PatchLocator {
 
     /// Distance from `p` to patch `i`'s pieces and the closest point on them.
     pub fn distance(&self, p: DVec3, i: usize) -> (f64, DVec3) {
+        let (d, q, _) = self.nearest_piece(p, i, f64::INFINITY);
+        (d, q)
+    }
+
+    /// The first of patch `i`'s pieces nearest to `p` — (distance, closest point, piece) — or
+    /// (∞, p, 0) when none comes within `bound`. A piece whose bounding sphere lies farther than
+    /// the best so far is skipped: no point of it is nearer than |p − c| − r, and the margin
+    /// (1e-9 grid units, far above the rounding of either side) keeps every piece that could
+    /// tie or win, so the answer is the one a full scan gives.
+    fn nearest_piece(&self, p: DVec3, i: usize, bound: f64) -> (f64, DVec3, usize) {
         let (first, count) = self.ranges[i];
-        let mut best = (f64::INFINITY, p);
-        for (poly, n) in &self.pieces[first..first + count] {
+        let mut best = (f64::INFINITY, p, 0);
+        for k in first..first + count {
+            let (c, r) = self.spheres[k];
+            if (p - c).length() - r > best.0.min(bound) + 1e-9 {
+                continue;
+            }
+            let (poly, n) = &self.pieces[k];
             let q = geometry::closest_point_on_polygon(p, poly, *n);
             let d = (q - p).length();
             if d < best.0 {
-                best = (d, q);
+                best = (d, q, k);
             }
         }
         best
@@ -120,13 +147,10 @@ impl PatchLocator {
 
     /// The unit normal of patch `i`'s piece nearest to `p`.
     pub fn piece_normal_near(&self, i: usize, p: DVec3) -> DVec3 {
-        let (first, count) = self.ranges[i];
-        self.pieces[first..first + count]
-            .iter()
-            .map(|(poly, n)| (geometry::distance_to_polygon(p, poly, *n), *n))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|b| b.1)
-            .unwrap_or(DVec3::Z)
+        match self.nearest_piece(p, i, f64::INFINITY) {
+            (d, _, k) if d.is_finite() => self.pieces[k].1,
+            _ => DVec3::Z,
+        }
     }
 
     /// The patch of `voxel` with `axis` nearest to `p`: (patch, distance, closest point).
@@ -136,9 +160,13 @@ impl PatchLocator {
         voxel: [i64; 3],
         axis: u8,
     ) -> Option<(u32, f64, DVec3)> {
+        // Each patch is searched within the nearest distance found so far (a patch that cannot
+        // tie it returns ∞), which changes no answer.
+        let mut bound = f64::INFINITY;
         self.candidates(voxel, axis)
             .map(|i| {
-                let (d, q) = self.distance(p, i);
+                let (d, q, _) = self.nearest_piece(p, i, bound);
+                bound = bound.min(d);
                 (i as u32, d, q)
             })
             .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))

@@ -65,7 +65,7 @@ impl Visibility {
         let normals = tris.iter().map(|t| t.compute_normal()).collect();
         let bvh = build_cwbvh_from_tris(
             &tris,
-            BvhBuildParams::medium_build(),
+            BvhBuildParams::slow_build(),
             &mut Duration::default(),
         );
         Visibility {
