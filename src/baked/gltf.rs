@@ -22,7 +22,8 @@
 //! Degenerate triangles are left out. Written atomically.
 
 use crate::error::{Error, Result};
-use crate::render::direct::{corner_indirect, gather_dense, patch_exitance};
+use crate::radiosity::corners::PointTransfer;
+use crate::render::direct::{gather_dense, patch_exitance};
 use crate::render::lights::{sun_light, GpuLight};
 use crate::render::mesh_reference::{shade_point, FrameSettings};
 use crate::render::raycast::RaycastScene;
@@ -93,7 +94,7 @@ pub fn lit_patches(dir: &Path, setup: &LitExport) -> Result<LitPatches> {
         if manifest.file(need).is_none() {
             return Err(Error::input(
                 dir,
-                format!("this bake has no `{need}`: lighting it needs a scene bake with `Voxelize` (see `relume-bake inspect`)"),
+                format!("this bake has no `{need}`: glTF export and per-object light need a scene bake with `Voxelize` (see `relume-bake inspect`)"),
             ));
         }
     }
@@ -150,15 +151,22 @@ pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitRe
         transport,
     } = lit_patches(dir, setup)?;
     let s = &setup.settings;
-    let indirect = corner_indirect(&set, &b);
-    // Shading data per corner as the player draws it (emitters lifted off their wall).
+    // Indirect light at every vertex of the split by the corners' own rule (PointTransfer):
+    // blending a triangle's three corners would spread one corner's light over a whole wall
+    // (the Cornell box's walls are one quad each). Shading data per corner as the player draws
+    // it (emitters lifted off their wall).
+    let transfer = PointTransfer::new(&scene, &set);
     let verts = rs.corner_data();
     let visible = rs.visible(&gpu_lights);
     let shade = |t: usize, w: [f32; 3]| -> [f32; 3] {
         let at = |k: usize, f: usize| Vec3::from_slice(&verts[12 * (3 * t + k) + f..][..3]);
         let blend = |f: usize| at(0, f) * w[0] + at(1, f) * w[1] + at(2, f) * w[2];
-        let ind = (0..3)
-            .map(|k| Vec3::from_slice(&indirect[3 * (3 * t + k)..][..3]) * w[k])
+        let c = scene.corners(t);
+        let p = c[0] * w[0] + c[1] * w[1] + c[2] * w[2];
+        let ind: Vec3 = transfer
+            .weights(&scene, t, p)
+            .iter()
+            .map(|&(j, wj)| Vec3::from(b[j as usize]) * wj)
             .sum();
         shade_point(
             s,

@@ -3,8 +3,8 @@ reference of relume's radiosity on the bundled rooms (a cross-check tool, never 
 
 usage: mitsuba_objects.py SCENE.obj SPP REPEATS [OBJECT_PREFIX ...]
 
-Reads the OBJ written by `relume-bake generate-scene` (v / o / usemtl / f lines, MTL with Kd and
-Ke), gives every object a face-normal mesh with a diffuse BSDF of its Kd and an area emitter of
+Reads a plain OBJ (v / o / usemtl / f lines, polygons fan-triangulated; MTL with Kd and Ke) as
+`relume-bake generate-scene` writes it, gives every object a face-normal mesh with a diffuse BSDF of its Kd and an area emitter of
 its Ke, and attaches an `irradiancemeter` (mean irradiance over the shape's whole area, in
 W/m^2, RGB) to each object whose name starts with one of the prefixes. Each object is rendered
 REPEATS times with different seeds, SPP samples each, by the `path` integrator with unbounded
@@ -23,6 +23,9 @@ mi.set_variant("scalar_rgb")
 
 path, spp, repeats = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 prefixes = sys.argv[4:] or [""]
+# RELUME_EMITTER_DROP=d moves emitters by d along -y: a light in its ceiling's plane (the Cornell
+# box) would otherwise z-fight with the ceiling in Mitsuba (relume cuts the ceiling instead).
+drop = float(os.environ.get("RELUME_EMITTER_DROP", "0"))
 
 materials, cur = {}, None
 with open(os.path.join(os.path.dirname(path), open(path).read().split("mtllib ")[1].split()[0])) as f:
@@ -51,7 +54,9 @@ with open(path) as f:
             mat = w[1]
         elif w[0] == "f":
             key = (obj, mat)
-            objects.setdefault(key, []).append([int(x.split("/")[0]) - 1 for x in w[1:4]])
+            poly = [int(x.split("/")[0]) - 1 for x in w[1:]]
+            for k in range(1, len(poly) - 1):
+                objects.setdefault(key, []).append([poly[0], poly[k], poly[k + 1]])
 verts = np.array(verts)
 
 tmp = tempfile.mkdtemp(prefix="relume-mitsuba-")
@@ -68,6 +73,14 @@ for (obj, mat), faces in objects.items():
     tri = verts[faces]
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
     m = materials[mat]
+    if max(m["Ke"]) > 0 and drop:
+        sub = verts[used].copy()
+        sub[:, 1] -= drop
+        with open(fname, "w") as f:
+            for v in sub:
+                f.write("v %r %r %r\n" % tuple(float(x) for x in v))
+            for t in inverse.reshape(-1, 3):
+                f.write("f %d %d %d\n" % tuple(t + 1))
     shape = {
         "type": "obj",
         "filename": fname,

@@ -11,15 +11,16 @@ use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::render::direct::gather_dense;
 use relume::scene::Scene;
 
-/// The scene `scenes/generated/NAME.obj`.
+/// The scene `scenes/generated/NAME.obj`, or the Cornell box (in metres) for "cornell".
 pub fn room(name: &str) -> Scene {
-    relume::scene::load_scene(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("scenes/generated/{name}.obj")),
-        Default::default(),
-    )
-    .unwrap()
-    .0
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (path, scale) = match name {
+        "cornell" => (root.join("scenes/cornell-box/cornell_box.obj"), 0.001),
+        _ => (root.join(format!("scenes/generated/{name}.obj")), 1.0),
+    };
+    relume::scene::load_scene(&path, relume::scene::SceneOptions { scale })
+        .unwrap()
+        .0
 }
 
 /// Per-object light of `scene` lit by its emitters, and the patch count.
