@@ -66,17 +66,16 @@ pub fn object_light(scene: &Scene, set: &PatchSet, b: &[[f32; 3]]) -> Vec<Object
         for k in 0..3 {
             let (ps, ws) = set.corners.list(3 * t + k);
             for (&p, &w) in ps.iter().zip(ws) {
-                for c in 0..3 {
-                    o.irradiance[c] += area / 3.0 * w as f64 * h[p as usize][c];
+                for (acc, hc) in o.irradiance.iter_mut().zip(h[p as usize]) {
+                    *acc += area / 3.0 * w as f64 * hc;
                 }
             }
         }
         let (ps, areas) = set.triangle_patches.list(t);
         for (&p, &a) in ps.iter().zip(areas) {
-            for c in 0..3 {
-                let h = h[p as usize][c];
-                o.irradiance_patches[c] += a as f64 * h;
-                o.max_patch_irradiance = o.max_patch_irradiance.max(h);
+            for (acc, hc) in o.irradiance_patches.iter_mut().zip(h[p as usize]) {
+                *acc += a as f64 * hc;
+                o.max_patch_irradiance = o.max_patch_irradiance.max(hc);
             }
             visible_area[scene.triangle_object[t] as usize] += a as f64;
         }
@@ -107,8 +106,8 @@ mod tests {
         let set = voxelize(&scene, &params).unwrap();
         let b = vec![[0.35f32, 0.7, 0.07]; set.patches.len()];
         for o in object_light(&scene, &set, &b) {
-            for c in 0..3 {
-                let want = b[0][c] as f64 / 0.7;
+            for (c, &bc) in b[0].iter().enumerate() {
+                let want = bc as f64 / 0.7;
                 assert!((o.irradiance[c] / want - 1.0).abs() < 1e-5, "{o:?}");
                 assert!((o.irradiance_patches[c] / want - 1.0).abs() < 1e-5, "{o:?}");
             }
