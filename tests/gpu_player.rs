@@ -105,11 +105,12 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     let b: Vec<[f32; 3]> = (0..n)
         .map(|i| [b_flat[i], b_flat[n + i], b_flat[2 * n + i]])
         .collect();
-    let corners = corner_indirect(&set, &b);
     let Player::Mesh(m) = &player else {
         panic!("a mesh bake")
     };
-    let rt = &m.radiosity.as_ref().expect("the bake has a transport").1;
+    // The player draws the display mesh (radiosity::display): its corners' lists.
+    let (display_set, rt) = m.radiosity.as_ref().expect("the bake has a transport");
+    let corners = corner_indirect(display_set, &b);
     let e_gpu = flat(&readback::read_f32(&gpu, &rt.exitance).unwrap());
     rel_close(&e_gpu[..3 * n], &e.concat(), 1e-6, "direct exitance");
     let b_gpu = flat(&readback::read_f32(&gpu, &rt.indirect).unwrap());
@@ -150,20 +151,24 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
         }
         sum / 25.0
     };
-    // Floor (y = 0) next to the red wall (x ≈ 0.55 m) against the floor's centre line, both in
-    // front of the blocks (z = 4 cm, where nothing hides the floor from the camera): the red
-    // wall's bounce light raises red relative to green there.
+    // Floor (y = 0) next to the red wall (x ≈ 0.55 m) against the floor next to the green wall
+    // (x ≈ 0), both in front of the blocks (z = 4 cm, where nothing hides the floor from the
+    // camera): bounce light raises red relative to green by the red wall and lowers it by the
+    // green one. The patches there (592-patch bake) have R/G 2.87 and 2.10; the frame, drawn on
+    // the display mesh, measured 1.46x (bound 1.2x). (Before the display mesh the floor was one
+    // quad, and the test compared with the floor's centre line, which only took the corners'
+    // blend.)
     let near_red = linear(Vec3::new(0.535, 0.0, 0.04));
-    let centre = linear(Vec3::new(0.278, 0.0, 0.04));
+    let near_green = linear(Vec3::new(0.02, 0.0, 0.04));
     let redness = |c: Vec3| c.x / c.y.max(1e-6);
     eprintln!(
-        "floor redness (R/G, linear): next to the red wall {:.3}, centre {:.3}",
+        "floor redness (R/G, linear): next to the red wall {:.3}, next to the green wall {:.3}",
         redness(near_red),
-        redness(centre)
+        redness(near_green)
     );
     assert!(
-        redness(near_red) > 1.1 * redness(centre),
-        "no colour bleeding: next to red wall {near_red}, centre {centre}"
+        redness(near_red) > 1.2 * redness(near_green),
+        "no colour bleeding: next to the red wall {near_red}, next to the green wall {near_green}"
     );
     let reference = RaycastScene::new(&m.scene).render(&camera, &lights, &s, &corners, w, h);
     let (mean_err, outliers) = compare(&gpu_img, &reference, 8);

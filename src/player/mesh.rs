@@ -10,6 +10,7 @@ use crate::gpu::mesh_renderer::MeshRenderer;
 use crate::gpu::radiosity_runtime::{RadiosityRuntime, TransportSource};
 use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
+use crate::radiosity::display::display_mesh_of;
 use crate::radiosity::PatchSet;
 use crate::render::camera::Camera;
 use crate::render::lights::GpuLight;
@@ -43,13 +44,36 @@ impl MeshPlayer {
         height: u32,
     ) -> Result<Self> {
         let scene = baked::scene::read(dir)?;
+        let has_transport = manifest.file(baked::encoded::TRANSFER_FILE).is_some()
+            || manifest.file(baked::transport::FILE).is_some();
+        // With baked light, draw the display mesh: triangles split to 1.5 voxels so that the
+        // per-vertex indirect light can follow the patches (radiosity::display).
+        let (scene, set) = if has_transport {
+            let mut set = baked::patches::read(dir)?;
+            if set.corners.len() != 3 * scene.triangles.len() {
+                return Err(super::mixed_bakes(
+                    dir,
+                    baked::patches::FILE,
+                    format!("covers {} mesh corners", set.corners.len()),
+                    format!("{} has {}", baked::scene::FILE, 3 * scene.triangles.len()),
+                ));
+            }
+            let (display, corners) = display_mesh_of(&scene, &set);
+            set.corners = corners;
+            (display, Some(set))
+        } else {
+            (scene, None)
+        };
         let renderer = MeshRenderer::new(gpu, &scene, width, height, SHADOW_SIZE)?;
         let scene_lights = scene
             .lights
             .iter()
             .map(|l| GpuLight::from_light(l, 1.0, 0))
             .collect();
-        let radiosity = load_radiosity(gpu, dir, manifest, opts, &renderer)?;
+        let radiosity = match set {
+            Some(set) => Some(load_radiosity(gpu, dir, manifest, opts, &renderer, set)?),
+            None => None,
+        };
         let mut p = MeshPlayer {
             scene,
             renderer,
@@ -119,29 +143,19 @@ impl MeshPlayer {
     }
 }
 
-/// The bake's light transfer on the GPU: the compressed transport when the bake has one (unless
-/// `opts` asks for the dense reference), else the dense `transport.npy`, else none.
+/// The bake's light transfer on the GPU for the patches `set` (its corners those of the
+/// renderer's mesh): the compressed transport when the bake has one (unless `opts` asks for the
+/// dense reference), else the dense `transport.npy`.
 fn load_radiosity(
     gpu: &Gpu,
     dir: &Path,
     manifest: &Manifest,
     opts: &PlayerOptions,
     renderer: &MeshRenderer,
-) -> Result<Option<(PatchSet, RadiosityRuntime)>> {
+    set: PatchSet,
+) -> Result<(PatchSet, RadiosityRuntime)> {
     let has_encoded = manifest.file(baked::encoded::TRANSFER_FILE).is_some();
     let has_dense = manifest.file(baked::transport::FILE).is_some();
-    if !has_encoded && !has_dense {
-        return Ok(None);
-    }
-    let set = baked::patches::read(dir)?;
-    if set.corners.len() != renderer.corners() as usize {
-        return Err(super::mixed_bakes(
-            dir,
-            baked::patches::FILE,
-            format!("covers {} mesh corners", set.corners.len()),
-            format!("{} has {}", baked::scene::FILE, renderer.corners()),
-        ));
-    }
     let patches = set.patches.len();
     let same_patches = |file: &str, n: usize| {
         if n == patches {
@@ -189,5 +203,5 @@ fn load_radiosity(
             renderer,
         )?
     };
-    Ok(Some((set, rt)))
+    Ok((set, rt))
 }

@@ -64,7 +64,7 @@ enum VisibilityRef<'a> {
 impl<'a> PointTransfer<'a> {
     /// Over `set`, the voxelization of `scene` (builds the visibility BVH).
     pub fn new(scene: &Scene, set: &PatchSet) -> PointTransfer<'static> {
-        let live = super::voxelize::live_triangles(scene);
+        let live = scene.live_triangles();
         let extent = set.dims.iter().copied().max().unwrap_or(1) as f64;
         let vis = Visibility::new(scene, &live, &set.frame(), extent);
         PointTransfer {

@@ -16,6 +16,7 @@
 
 pub mod clip;
 pub mod corners;
+pub mod display;
 pub mod fixtures;
 pub mod formfactor;
 pub mod geometry;

@@ -1,7 +1,7 @@
 //! Light per scene object: the mean irradiance over each object's surface from per-patch
-//! exitance, two ways — through the per-corner interpolation (what the player and the glTF
-//! export show) and straight from the patches each triangle's visible area went into (the
-//! radiosity solution itself). This is the quantity a path tracer's irradiance meter measures
+//! exitance, two ways — through the per-corner interpolation on the display mesh (what the
+//! player shows, `radiosity::display`) and straight from the patches each triangle's visible
+//! area went into (the radiosity solution itself). This is the quantity a path tracer's irradiance meter measures
 //! on the same object, so it is how bakes are compared with Mitsuba (`tests/radiosity_rooms.rs`)
 //! and how the study reports per-object error.
 //!
@@ -22,7 +22,7 @@ pub struct ObjectLight {
     pub name: String,
     /// Total triangle area (scene units²).
     pub area: f64,
-    /// Mean irradiance from the corner interpolation, per channel.
+    /// Mean irradiance from the corner interpolation on the display mesh, per channel.
     pub irradiance: [f64; 3],
     /// Mean irradiance from the patches (area-weighted over each triangle's visible pieces).
     pub irradiance_patches: [f64; 3],
@@ -58,19 +58,25 @@ pub fn object_light(scene: &Scene, set: &PatchSet, b: &[[f32; 3]]) -> Vec<Object
             })
         })
         .collect();
-    let mut visible_area = vec![0.0f64; out.len()];
-    for t in 0..scene.triangles.len() {
-        let o = &mut out[scene.triangle_object[t] as usize];
-        let area = scene.triangle_area(t) as f64;
+    // Through the corners of the mesh the player draws (radiosity::display).
+    let (display, lists) = super::display::display_mesh_of(scene, set);
+    for t in 0..display.triangles.len() {
+        let o = &mut out[display.triangle_object[t] as usize];
+        let area = display.triangle_area(t) as f64;
         o.area += area;
         for k in 0..3 {
-            let (ps, ws) = set.corners.list(3 * t + k);
+            let (ps, ws) = lists.list(3 * t + k);
             for (&p, &w) in ps.iter().zip(ws) {
                 for (acc, hc) in o.irradiance.iter_mut().zip(h[p as usize]) {
                     *acc += area / 3.0 * w as f64 * hc;
                 }
             }
         }
+    }
+    // Straight from the patches each scene triangle's visible area went into.
+    let mut visible_area = vec![0.0f64; out.len()];
+    for t in 0..scene.triangles.len() {
+        let o = &mut out[scene.triangle_object[t] as usize];
         let (ps, areas) = set.triangle_patches.list(t);
         for (&p, &a) in ps.iter().zip(areas) {
             for (acc, hc) in o.irradiance_patches.iter_mut().zip(h[p as usize]) {

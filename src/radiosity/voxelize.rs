@@ -176,10 +176,7 @@ pub use super::clip::clip_to_voxels;
 
 /// The scene's non-degenerate triangles (the ones the bake uses), in scene order.
 pub fn live_triangles(scene: &Scene) -> Vec<u32> {
-    let degenerate: std::collections::BTreeSet<usize> = scene.degenerate_triangles().collect();
-    (0..scene.triangles.len() as u32)
-        .filter(|t| !degenerate.contains(&(*t as usize)))
-        .collect()
+    scene.live_triangles()
 }
 
 fn build_patch(

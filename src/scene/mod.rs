@@ -265,6 +265,14 @@ impl Scene {
         })
     }
 
+    /// Indices of the triangles that are not degenerate: what the bake voxelizes and traces.
+    pub fn live_triangles(&self) -> Vec<u32> {
+        let degenerate: std::collections::BTreeSet<usize> = self.degenerate_triangles().collect();
+        (0..self.triangles.len() as u32)
+            .filter(|t| !degenerate.contains(&(*t as usize)))
+            .collect()
+    }
+
     /// Axis-aligned bounds (min, max) of all vertices referenced by triangles.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::INFINITY);
