@@ -294,10 +294,11 @@ pub fn to_row_major(s: &Mat<f32>) -> Vec<f32> {
 
 /// Collatz–Wielandt bounds (lower, upper) on the spectral radius of a non-negative matrix, from
 /// at most 64 steps of power iteration started at the all-ones vector, stopping once the
-/// bounds are within 1e-7 of each other, or within 1e-3 with the upper one below 0.999 (each
-/// product by fixed chunks of columns in parallel,
-/// summed in f64 in the same order whatever the thread count).
-pub fn spectral_bounds(m: &Mat<f32>) -> (f64, f64) {
+/// bounds are within 1e-7 of each other, or within 1e-3 with the upper one below 0.999, or —
+/// when `enough_below` is given — as soon as the upper bound is below it (the first step's
+/// bounds are the smallest and largest row sums). Each product by fixed chunks of columns in
+/// parallel, summed in f64 in the same order whatever the thread count.
+pub fn spectral_bounds(m: &Mat<f32>, enough_below: Option<f64>) -> (f64, f64) {
     let n = m.nrows();
     let mut x = vec![1f64; n];
     let mut bounds: (f64, f64) = (0.0, f64::INFINITY);
@@ -324,7 +325,10 @@ pub fn spectral_bounds(m: &Mat<f32>) -> (f64, f64) {
             // only a lower bound ≥ 1 − 1e-6, which such a matrix cannot have, and the bounds
             // are otherwise a report.
             let gap = bounds.1 - bounds.0;
-            if gap <= 1e-7 * bounds.1 || (gap <= 1e-3 * bounds.1 && bounds.1 < 0.999) {
+            if gap <= 1e-7 * bounds.1
+                || (gap <= 1e-3 * bounds.1 && bounds.1 < 0.999)
+                || enough_below.is_some_and(|t| bounds.1 < t)
+            {
                 break;
             }
         }

@@ -153,13 +153,16 @@ pub fn transport(
                 (s, k, p)
             }
             Bounces::Auto(tol) => {
-                let bounds = spectral_bounds(&m);
+                let bounds = spectral_bounds(&m, None);
                 out.spectral_bounds.push(bounds);
                 refuse_divergent(bounds, "Auto")?;
                 auto_sum(&m, tol)?
             }
             Bounces::Infinite => {
-                let bounds = spectral_bounds(&m);
+                // Only the refusal needs the bound here: once the largest row sum of M is
+                // below 1 − margin (every albedo below 1 and rows summing to at most 1), the
+                // spectral radius is too, and the power iteration stops after its first step.
+                let bounds = spectral_bounds(&m, Some(1.0 - SPECTRAL_MARGIN));
                 out.spectral_bounds.push(bounds);
                 refuse_divergent(bounds, "Infinite")?;
                 let n2 = (n * n) as u64;
