@@ -100,7 +100,7 @@ pub fn check_extension(path: &Path, allowed: &[&str]) -> Result<()> {
         Err(Error::unsupported(
             path,
             format!(
-                "cannot write this image type; use one of: {}",
+                "cannot write this file type; use one of: {}",
                 allowed
                     .iter()
                     .map(|a| format!(".{a}"))
