@@ -75,6 +75,9 @@ docs-images: build
 	$(BAKE) -q run pipelines/cornell.ron --out $(DOCS_OUT)/cornell
 	$(BAKE) -q run pipelines/gltf-room.ron --out $(DOCS_OUT)/gltf-room
 	$(BAKE) -q run pipelines/puget-sound-2k.ron --out $(DOCS_OUT)/puget-sound-2k
+	$(BAKE) -q run pipelines/furnished-room.ron --out $(DOCS_OUT)/furnished-room
+	$(PLAYER) $(DOCS_OUT)/furnished-room --headless -q --size 640x400 --exposure 2.5 \
+	    --camera 8.7,1.75,0.4,3.2,0.8,3.0,70 --out $(DOCS_OUT)/furnished-room-frames
 	$(PLAYER) $(DOCS_OUT)/cornell --headless -q --size 480x360 --exposure 2 --out $(DOCS_OUT)/cornell-frames
 	$(PLAYER) $(DOCS_OUT)/cornell --headless -q --size 480x360 --sun 20,30 --frames 4 --out $(DOCS_OUT)/cornell-sun-frames
 	$(PLAYER) $(DOCS_OUT)/gltf-room --headless -q --size 480x360 --exposure 2 \
@@ -87,6 +90,7 @@ docs-images: build
 	cp $(DOCS_OUT)/cornell-frames/frame_0000.png docs/images/cornell.png
 	cp $(DOCS_OUT)/cornell-sun-frames/frame_0001.png docs/images/cornell-sun.png
 	cp $(DOCS_OUT)/gltf-room-frames/frame_0000.png docs/images/gltf-room.png
+	cp $(DOCS_OUT)/furnished-room-frames/frame_0000.png docs/images/furnished-room.png
 	cp $(DOCS_OUT)/terrain-frames/frame_0000.png docs/images/puget-sound-player.png
 	for s in csg-holes terrain-16 blobs-128 planet; do \
 	    $(BAKE) -q freeform render scenes/freeform/$$s.ron --size 320x240 \
