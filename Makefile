@@ -140,9 +140,9 @@ deps-apt:
 	fi
 
 deps-py:
-	@python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex" 2>/dev/null || { \
+	@python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex, mitsuba" 2>/dev/null || { \
 	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) && \
-	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex"; } || \
+	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex, mitsuba"; } || \
 	  { echo "error: cannot install the Python cross-check readers ($(PY_PKGS))" >&2; exit 1; }
 
 ## The Khronos glTF-Validator for the glTF export's test (Node and npm; pinned in tools/npm).
