@@ -23,6 +23,7 @@
 
 use crate::error::{Error, Result};
 use crate::radiosity::corners::PointTransfer;
+use crate::radiosity::visibility::Visibility;
 use crate::render::direct::{gather_dense, patch_exitance};
 use crate::render::lights::{sun_light, GpuLight};
 use crate::render::mesh_reference::{shade_point, FrameSettings};
@@ -155,7 +156,8 @@ pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitRe
     // blending a triangle's three corners would spread one corner's light over a whole wall
     // (the Cornell box's walls are one quad each). Shading data per corner as the player draws
     // it (emitters lifted off their wall).
-    let transfer = PointTransfer::new(&scene, &set);
+    let vis = Visibility::for_patches(&scene, &set);
+    let transfer = PointTransfer::new(&scene, &set, &vis);
     let verts = rs.corner_data();
     let visible = rs.visible(&gpu_lights);
     let shade = |t: usize, w: [f32; 3]| -> [f32; 3] {
@@ -164,7 +166,8 @@ pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitRe
         let c = scene.corners(t);
         let p = c[0] * w[0] + c[1] * w[1] + c[2] * w[2];
         let ind: Vec3 = transfer
-            .weights(&scene, t, p)
+            .on_triangle(&scene, t)
+            .weights(p)
             .iter()
             .map(|&(j, wj)| Vec3::from(b[j as usize]) * wj)
             .sum();

@@ -30,81 +30,73 @@ const PLANE_DISTANCE: f64 = 0.5;
 /// Per-corner transfer lists (`3 * triangle + corner`) for every scene triangle; degenerate
 /// triangles get empty lists. `vis` must be built over the same grid frame as `set`.
 pub fn corner_patches(scene: &Scene, set: &PatchSet, vis: &Visibility) -> PatchLists {
-    let transfer = PointTransfer::with_visibility(scene, set, vis);
-    let degenerate: std::collections::BTreeSet<usize> = scene.degenerate_triangles().collect();
+    let transfer = PointTransfer::new(scene, set, vis);
     let lists: Vec<[Vec<(u32, f32)>; 3]> = (0..scene.triangles.len())
         .into_par_iter()
         .map(|t| {
-            if degenerate.contains(&t) {
+            if scene.is_degenerate(t) {
                 return Default::default();
             }
-            let corners = scene.triangles[t].map(|v| glam::Vec3::from(scene.positions[v as usize]));
-            std::array::from_fn(|c| transfer.weights(scene, t, corners[c]))
+            let on = transfer.on_triangle(scene, t);
+            scene.triangles[t].map(|v| on.weights(glam::Vec3::from(scene.positions[v as usize])))
         })
         .collect();
     PatchLists::from_lists(lists.into_iter().flatten().collect())
 }
 
 /// The transfer weights of any point on a scene triangle, by the rule of the corners: what the
-/// glTF export uses at the vertices of a split triangle, where blending the triangle's three
-/// corners would spread one corner's light over a whole wall.
+/// display mesh (`radiosity::display`) and the glTF export use at the vertices of a split
+/// triangle, where blending the triangle's three corners would spread one corner's light over
+/// a whole wall. `vis` is the BVH of the voxelization ([`Visibility::for_patches`]).
 pub struct PointTransfer<'a> {
     locator: PatchLocator,
-    vis: VisibilityRef<'a>,
+    vis: &'a Visibility,
     frame: super::geometry::Frame,
     dims: [u32; 3],
     lift: f64,
 }
 
-enum VisibilityRef<'a> {
-    Borrowed(&'a Visibility),
-    Owned(Box<Visibility>),
+/// A scene triangle's plane in grid coordinates, for [`PointTransfer`] queries on it.
+pub struct OnTriangle<'t, 'a> {
+    transfer: &'t PointTransfer<'a>,
+    normal: DVec3,
+    centre: DVec3,
 }
 
 impl<'a> PointTransfer<'a> {
-    /// Over `set`, the voxelization of `scene` (builds the visibility BVH).
-    pub fn new(scene: &Scene, set: &PatchSet) -> PointTransfer<'static> {
-        let live = scene.live_triangles();
-        let extent = set.dims.iter().copied().max().unwrap_or(1) as f64;
-        let vis = Visibility::new(scene, &live, &set.frame(), extent);
+    pub fn new(scene: &Scene, set: &PatchSet, vis: &'a Visibility) -> Self {
         PointTransfer {
             locator: PatchLocator::new(set, scene),
-            lift: 4.0 * vis.epsilon as f64,
-            vis: VisibilityRef::Owned(Box::new(vis)),
-            frame: set.frame(),
-            dims: set.dims,
-        }
-    }
-
-    fn with_visibility(scene: &Scene, set: &PatchSet, vis: &'a Visibility) -> Self {
-        PointTransfer {
-            locator: PatchLocator::new(set, scene),
-            vis: VisibilityRef::Borrowed(vis),
-            frame: set.frame(),
-            dims: set.dims,
-            lift: 4.0 * vis.epsilon as f64,
-        }
-    }
-
-    /// Weights (patch, weight summing to 1) of the point `p` (world) on scene triangle `t`.
-    pub fn weights(&self, scene: &Scene, t: usize, p: glam::Vec3) -> Vec<(u32, f32)> {
-        let corners = scene.triangles[t].map(|v| self.frame.to_grid(scene.positions[v as usize]));
-        let n = (corners[1] - corners[0])
-            .cross(corners[2] - corners[0])
-            .normalize();
-        let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let vis = match &self.vis {
-            VisibilityRef::Borrowed(v) => v,
-            VisibilityRef::Owned(v) => v.as_ref(),
-        };
-        corner_weights(
-            self.frame.to_grid(p.to_array()),
-            n,
-            centre,
-            &self.locator,
             vis,
-            self.dims,
-            self.lift,
+            frame: set.frame(),
+            dims: set.dims,
+            lift: 4.0 * vis.epsilon as f64,
+        }
+    }
+
+    /// Queries on scene triangle `t` (its normal and centre computed once).
+    pub fn on_triangle(&self, scene: &Scene, t: usize) -> OnTriangle<'_, 'a> {
+        let c = scene.triangles[t].map(|v| self.frame.to_grid(scene.positions[v as usize]));
+        OnTriangle {
+            transfer: self,
+            normal: (c[1] - c[0]).cross(c[2] - c[0]).normalize(),
+            centre: (c[0] + c[1] + c[2]) / 3.0,
+        }
+    }
+}
+
+impl OnTriangle<'_, '_> {
+    /// Weights (patch, weight summing to 1) of the point `p` (world) on the triangle.
+    pub fn weights(&self, p: glam::Vec3) -> Vec<(u32, f32)> {
+        let t = self.transfer;
+        corner_weights(
+            t.frame.to_grid(p.to_array()),
+            self.normal,
+            self.centre,
+            &t.locator,
+            t.vis,
+            t.dims,
+            t.lift,
         )
     }
 }

@@ -11,6 +11,7 @@
 //! never traced.
 
 use super::corners::PointTransfer;
+use super::visibility::Visibility;
 use super::{PatchLists, PatchSet};
 use crate::scene::Scene;
 use glam::DVec3;
@@ -32,6 +33,9 @@ pub fn display_mesh_of(scene: &Scene, set: &PatchSet) -> (Scene, PatchLists) {
 pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, PatchLists) {
     let split: Vec<usize> = (0..scene.triangles.len())
         .map(|t| {
+            if scene.is_degenerate(t) {
+                return 1;
+            }
             let c = scene.corners(t);
             let longest = (0..3)
                 .map(|k| (c[(k + 1) % 3] - c[k]).length() as f64)
@@ -39,17 +43,17 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
             ((longest / max_edge).ceil() as usize).clamp(1, MAX_SPLIT)
         })
         .collect();
-    let degenerate: std::collections::BTreeSet<usize> = scene.degenerate_triangles().collect();
     if split.iter().all(|&m| m == 1) {
         return (scene.clone(), set.corners.clone());
     }
-    let transfer = PointTransfer::new(scene, set);
-    // Per scene triangle: sub-triangle corner positions and their lists.
+    let vis = Visibility::for_patches(scene, set);
+    let transfer = PointTransfer::new(scene, set, &vis);
+    // Per scene triangle: its sub-triangles' corner positions and lists, three per sub-triangle.
     type Part = (Vec<[f32; 3]>, Vec<Vec<(u32, f32)>>);
     let parts: Vec<Part> = (0..scene.triangles.len())
         .into_par_iter()
         .map(|t| {
-            let m = if degenerate.contains(&t) { 1 } else { split[t] };
+            let m = split[t];
             let own = |k: usize| {
                 let (p, w) = set.corners.list(3 * t + k);
                 p.iter().copied().zip(w.iter().copied()).collect::<Vec<_>>()
@@ -58,37 +62,42 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
                 let pos = scene.triangles[t].map(|v| scene.positions[v as usize]);
                 return (pos.to_vec(), (0..3).map(own).collect());
             }
+            // The grid vertices (i, j), i + j ≤ m, at barycentric (1 − (i + j)/m, i/m, j/m),
+            // row by row; the scene's own corners keep the bake's lists.
             let c =
                 scene.triangles[t].map(|v| DVec3::from(scene.positions[v as usize].map(f64::from)));
-            let grid = |i: usize, j: usize| {
-                let (u, v) = (i as f64 / m as f64, j as f64 / m as f64);
-                (c[0] + (c[1] - c[0]) * u + (c[2] - c[0]) * v).as_vec3()
-            };
-            // Weights once per grid vertex (the scene's own corners keep the bake's lists).
-            let mut weights = std::collections::HashMap::new();
-            let mut at = |i: usize, j: usize| -> ([f32; 3], Vec<(u32, f32)>) {
-                let p = grid(i, j);
-                let w = weights
-                    .entry((i, j))
-                    .or_insert_with(|| match (i, j) {
+            let on = transfer.on_triangle(scene, t);
+            let row = |i: usize| i * (m + 1) - i * (i.saturating_sub(1)) / 2;
+            let index = |i: usize, j: usize| row(i) + j;
+            let mut verts = Vec::with_capacity(row(m) + 1);
+            for i in 0..=m {
+                for j in 0..=m - i {
+                    let (u, v) = (i as f64 / m as f64, j as f64 / m as f64);
+                    let p = (c[0] + (c[1] - c[0]) * u + (c[2] - c[0]) * v).as_vec3();
+                    let w = match (i, j) {
                         (0, 0) => own(0),
                         (i, 0) if i == m => own(1),
                         (0, j) if j == m => own(2),
-                        _ => transfer.weights(scene, t, p),
-                    })
-                    .clone();
-                (p.to_array(), w)
-            };
+                        _ => on.weights(p),
+                    };
+                    verts.push((p.to_array(), w));
+                }
+            }
             let (mut pos, mut lists) = (Vec::new(), Vec::new());
+            let mut corner = |i: usize, j: usize| {
+                let (p, w) = &verts[index(i, j)];
+                pos.push(*p);
+                lists.push(w.clone());
+            };
             for i in 0..m {
                 for j in 0..m - i {
-                    let mut tri = vec![at(i, j), at(i + 1, j), at(i, j + 1)];
+                    corner(i, j);
+                    corner(i + 1, j);
+                    corner(i, j + 1);
                     if i + j + 1 < m {
-                        tri.extend([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
-                    }
-                    for (p, w) in tri {
-                        pos.push(p);
-                        lists.push(w);
+                        corner(i + 1, j);
+                        corner(i + 1, j + 1);
+                        corner(i, j + 1);
                     }
                 }
             }

@@ -59,7 +59,7 @@ pub fn voxelize_noting(
     scene: &Scene,
     params: &VoxelizeParams,
 ) -> Result<(PatchSet, Option<String>)> {
-    let live = live_triangles(scene);
+    let live = scene.live_triangles();
     let degenerate = scene.triangles.len() - live.len();
     if live.is_empty() {
         return Err(Error::input(
@@ -173,11 +173,6 @@ pub fn voxelize_noting(
 }
 
 pub use super::clip::clip_to_voxels;
-
-/// The scene's non-degenerate triangles (the ones the bake uses), in scene order.
-pub fn live_triangles(scene: &Scene) -> Vec<u32> {
-    scene.live_triangles()
-}
 
 fn build_patch(
     scene: &Scene,

@@ -38,7 +38,7 @@ impl RaycastScene {
             materials: vec![Material::default_grey()],
             lights: Vec::new(),
         };
-        let live = crate::radiosity::voxelize::live_triangles(&flat);
+        let live = flat.live_triangles();
         let (lo, hi) = flat.bounds();
         let extent = lo.abs().max(hi.abs()).max_element().max(1e-6);
         let vis = Visibility::new(

@@ -256,20 +256,22 @@ impl Scene {
 
     /// Indices of triangles whose area is zero (or not a normal number) relative to their size.
     pub fn degenerate_triangles(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..self.triangles.len()).filter(move |&t| {
-            let [a, b, c] = self.corners(t);
-            let cross = (b - a).cross(c - a).length();
-            let scale = (b - a).length_squared().max((c - a).length_squared());
-            cross.partial_cmp(&(scale * 1e-12)) != Some(std::cmp::Ordering::Greater)
-                || !cross.is_normal()
-        })
+        (0..self.triangles.len()).filter(move |&t| self.is_degenerate(t))
+    }
+
+    /// True when triangle `t` has zero area (or not a normal number) relative to its size.
+    pub fn is_degenerate(&self, t: usize) -> bool {
+        let [a, b, c] = self.corners(t);
+        let cross = (b - a).cross(c - a).length();
+        let scale = (b - a).length_squared().max((c - a).length_squared());
+        cross.partial_cmp(&(scale * 1e-12)) != Some(std::cmp::Ordering::Greater)
+            || !cross.is_normal()
     }
 
     /// Indices of the triangles that are not degenerate: what the bake voxelizes and traces.
     pub fn live_triangles(&self) -> Vec<u32> {
-        let degenerate: std::collections::BTreeSet<usize> = self.degenerate_triangles().collect();
         (0..self.triangles.len() as u32)
-            .filter(|t| !degenerate.contains(&(*t as usize)))
+            .filter(|&t| !self.is_degenerate(t as usize))
             .collect()
     }
 

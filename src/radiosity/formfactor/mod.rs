@@ -21,7 +21,7 @@ pub mod reciprocal;
 
 use super::locate::PatchLocator;
 use super::visibility::Visibility;
-use super::voxelize::{live_triangles, piece_sampler};
+use super::voxelize::piece_sampler;
 use super::PatchSet;
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -98,11 +98,10 @@ pub struct Context {
 impl Context {
     pub fn new(scene: &Scene, set: &PatchSet) -> Self {
         let samplers = set.patches.iter().map(|p| piece_sampler(set, p)).collect();
-        let extent = set.dims.iter().copied().max().unwrap_or(1) as f64;
         Context {
             samplers,
             locator: PatchLocator::new(set, scene),
-            vis: Visibility::new(scene, &live_triangles(scene), &set.frame(), extent),
+            vis: Visibility::for_patches(scene, set),
         }
     }
 }
