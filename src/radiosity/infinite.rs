@@ -2,29 +2,32 @@
 //! f32 helpers the transport uses around faer (row-major ↔ column-major copies, the spectral
 //! bounds), each parallel over blocks with rayon and independent of the thread count.
 //!
-//! **The solve.** One LU with partial pivoting (faer) of `I − M` in **f32**, then its inverse
-//! minus I (4/3 n³ flops after the LU's 2/3 n³, against 2n³ for a solve with n right-hand
-//! sides; the diagonal, where subtracting I would cost precision, is computed as
-//! `Σ_q (I − M)⁻¹(i, q) M(q, i)` in f64), checked a posteriori: for 32 columns spread over S, the residual
-//! `r_j = m_j − (I − M) s_j` in f64 and one correction `δ_j = (I − M)⁻¹ r_j` with the same f32
-//! factors. That is one step of iterative refinement on those columns, so `max |δ| / max |S|`
-//! estimates the solve's forward error (tested against the f64 LU: within 3x on the Cornell
-//! box and furnaces up to ρ = 0.999). When the estimate is over [`F32_ACCEPT`], the **f64** LU
-//! (the reference) solves it instead, after checking its larger memory against the budget.
+//! **The solve.** One LU with partial pivoting (faer) of `I − M` in **f32**, then S by fixed
+//! panels of columns ([`super::lu_panels`]: the flops of one GEMM in all, and any set of panels
+//! can be solved by another process — `relume-bake run --shard`). It is checked a priori, before
+//! any panel: for 32 columns j spread over S, `s_j` solves `(I − M) s_j = m_j`, the residual
+//! `r_j = m_j − (I − M) s_j` is summed in f64 and one correction `δ_j = (I − M)⁻¹ r_j` is solved
+//! with the same f32 factors. That is one step of iterative refinement on those columns, so
+//! `max |δ| / max |s|` estimates the solve's forward error (tested against the f64 LU on the
+//! Cornell box and furnaces up to ρ = 0.999). When the estimate is over [`F32_ACCEPT`], the
+//! **f64** LU (the reference) solves it instead, after checking its larger memory against the
+//! budget. The check depends only on M, so every shard of a bake takes the same decision.
 //!
 //! Preconditions: M square, non-negative, with spectral radius < 1 (the caller refuses
 //! divergent matrices first).
 
-use crate::error::{Error, Result};
-use faer::linalg::solvers::{DenseSolveCore, Solve};
+pub use super::lu_panels::RowMajor;
+use super::lu_panels::{panel_count, scatter, Factored, Panel, Real};
+use crate::error::Result;
 use faer::Mat;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::ops::Range;
 
 /// How `Bounces::Infinite` solves `(I − M) S = M`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum InfiniteSolver {
-    /// f32 LU when its a-posteriori error estimate is at most [`F32_ACCEPT`] of the largest
+    /// f32 LU when its a-priori error estimate is at most [`F32_ACCEPT`] of the largest
     /// entry, else f64 (the default).
     #[default]
     Auto,
@@ -38,23 +41,14 @@ pub enum InfiniteSolver {
 /// (a tenth of the 1e-5 the tests hold both solvers to against the f64 reference).
 pub const F32_ACCEPT: f64 = 1e-6;
 
-/// Working bytes per matrix entry of the f64 solve: M in f32 and, while faer solves, the f64 LU
-/// factor, the f64 solution and faer's f64 scratch, 28 bytes per entry, plus 2 of slack (33
-/// and 34 measured, peak RSS less the form factors and the output, on 3- and 1-channel bakes of
-/// about 4,000 patches).
-pub const F64_BYTES_PER_ENTRY: u64 = 30;
-/// The same for the f32 solve: M, I − M, its LU factor and the inverse (16), plus 2 of slack.
-pub const F32_BYTES_PER_ENTRY: u64 = 18;
+/// Working bytes per matrix entry of the f64 solve besides F and the output: the f64 LU factor
+/// (8) and slack (2).
+pub const F64_BYTES_PER_ENTRY: u64 = 10;
+/// The same for the f32 solve: the f32 LU factor (4) and slack (2).
+pub const F32_BYTES_PER_ENTRY: u64 = 6;
 
 /// Rows or columns per parallel block of the dense helpers.
 const BLOCK: usize = 64;
-
-/// M in row-major order as the transport has it: `M(q, i) = rho[q] · f[q·n + i]`.
-#[derive(Clone, Copy)]
-pub struct RowMajor<'a> {
-    pub f: &'a [f32],
-    pub rho: &'a [f32],
-}
 
 /// Columns per chunk of the reductions over columns (fixed, so sums do not depend on the
 /// thread count).
@@ -82,174 +76,113 @@ fn column_sums(n: usize, cols: usize, term: impl Fn(usize, &mut [f64]) + Sync) -
     out
 }
 
-/// S = (I − M)⁻¹ M with `solver`; `check_memory(bytes, why)` is called before the f64 solve
-/// allocates. Returns S, the solver used and the f32 solve's estimated relative error (0 when
-/// the f64 LU solved it without an f32 attempt).
-pub fn infinite(
-    m: &Mat<f32>,
-    rows: RowMajor,
+/// A factored infinite-bounce solve of one channel, in the precision chosen.
+pub enum InfiniteFactor {
+    F32(Factored<f32>),
+    F64(Factored<f64>),
+}
+
+impl InfiniteFactor {
+    /// Number of panels of this solve.
+    pub fn panels(&self) -> usize {
+        match self {
+            InfiniteFactor::F32(f) => panel_count(f.n()),
+            InfiniteFactor::F64(f) => panel_count(f.n()),
+        }
+    }
+
+    /// The columns of S of panels `range`.
+    pub fn solve_panels(&self, range: Range<usize>, m: RowMajor) -> Result<Vec<Panel>> {
+        range
+            .map(|p| match self {
+                InfiniteFactor::F32(f) => f.panel(p, m),
+                InfiniteFactor::F64(f) => f.panel(p, m),
+            })
+            .collect()
+    }
+}
+
+/// Factor `I − M` with `solver` (f32 first unless F64 is asked for; f64 when the f32 check fails
+/// under Auto, after `check_memory(bytes, why)`). Returns the factors, the solver used and the
+/// f32 solve's estimated relative error (0 when the f64 LU solved it without an f32 attempt).
+pub fn factor_infinite(
+    m: RowMajor,
     solver: InfiniteSolver,
     check_memory: &dyn Fn(u64, String) -> Result<()>,
-) -> Result<(Mat<f32>, InfiniteSolver, f64)> {
+) -> Result<(InfiniteFactor, InfiniteSolver, f64)> {
+    let n = m.rho.len();
     let mut estimate = 0.0;
     if solver != InfiniteSolver::F64 {
-        let (s, err) = infinite_f32(m, rows)?;
+        let f32_lu = Factored::<f32>::new(m)?;
+        let err = error_estimate(&f32_lu, m);
         if solver == InfiniteSolver::F32 || err <= F32_ACCEPT {
-            return Ok((s, InfiniteSolver::F32, err));
+            return Ok((InfiniteFactor::F32(f32_lu), InfiniteSolver::F32, err));
         }
         estimate = err;
     }
-    let n2 = (m.nrows() * m.nrows()) as u64;
+    let n2 = (n * n) as u64;
     check_memory(
         n2 * F64_BYTES_PER_ENTRY,
         format!(
-            "the f64 infinite-bounce solve of {} patches (the f32 solve's estimated error, \
-             {estimate:.1e}, is over {F32_ACCEPT:e}: the spectral radius is close to 1)",
-            m.nrows()
+            "the f64 infinite-bounce solve of {n} patches (the f32 solve's estimated error, \
+             {estimate:.1e}, is over {F32_ACCEPT:e}: the spectral radius is close to 1)"
         ),
     )?;
-    Ok((infinite_f64(m)?, InfiniteSolver::F64, estimate))
+    let f64_lu = Factored::<f64>::new(m)?;
+    Ok((InfiniteFactor::F64(f64_lu), InfiniteSolver::F64, estimate))
 }
 
-/// Refuse a factorisation with a zero or non-finite pivot (|U_ii| over the diagonal).
-fn check_pivots(diag: impl Iterator<Item = f64>) -> Result<()> {
-    let (mut lo, mut hi) = (f64::INFINITY, 0f64);
-    for d in diag {
-        let d = d.abs();
-        lo = lo.min(d);
-        hi = hi.max(d);
+/// S = (I − M)⁻¹ M, row-major, with `solver` (see [`factor_infinite`]).
+pub fn infinite(
+    m: RowMajor,
+    solver: InfiniteSolver,
+    check_memory: &dyn Fn(u64, String) -> Result<()>,
+) -> Result<(Vec<f32>, InfiniteSolver, f64)> {
+    let n = m.rho.len();
+    let (lu, used, err) = factor_infinite(m, solver, check_memory)?;
+    let mut out = vec![0f32; n * n];
+    // Panels in groups, so the columns in flight stay a small part of S.
+    let group = 8;
+    for g in (0..lu.panels()).step_by(group) {
+        let panels = lu.solve_panels(g..(g + group).min(lu.panels()), m)?;
+        scatter(&panels, n, &mut out);
     }
-    if !(lo.is_finite() && hi.is_finite()) || lo <= 1e-12 * hi.max(1.0) {
-        return Err(Error::knob(format!(
-            "transport: I − diag(albedo)·F is singular (smallest LU pivot {lo:e}): infinite bounces diverge; use `bounces: Finite(k)`"
-        )));
-    }
-    Ok(())
+    Ok((out, used, err))
 }
 
-fn non_finite() -> Error {
-    Error::knob(
-        "transport: the infinite-bounce solve produced a non-finite value; use `bounces: Finite(k)`",
-    )
-}
-
-/// `(I − M)⁻¹ M` by LU with partial pivoting in f64: the reference.
-pub fn infinite_f64(m: &Mat<f32>) -> Result<Mat<f32>> {
-    let n = m.nrows();
-    let a = Mat::<f64>::from_fn(n, n, |i, j| f64::from(i == j) - m[(i, j)] as f64);
-    let lu = a.partial_piv_lu();
-    drop(a);
-    let u = lu.U();
-    check_pivots((0..n).map(|i| u[(i, i)]))?;
-    let mut x = Mat::<f64>::from_fn(n, n, |i, j| m[(i, j)] as f64);
-    lu.solve_in_place(x.as_mut());
-    let mut s = Mat::<f32>::zeros(n, n);
-    s.par_col_iter_mut().enumerate().try_for_each(|(j, col)| {
-        let src = x.col_as_slice(j);
-        for (d, &v) in col
-            .try_as_col_major_mut()
-            .unwrap()
-            .as_slice_mut()
-            .iter_mut()
-            .zip(src)
-        {
-            if !v.is_finite() {
-                return Err(non_finite());
-            }
-            *d = v.max(0.0) as f32; // rounding noise around exact zeros
-        }
-        Ok(())
-    })?;
-    Ok(s)
-}
-
-/// `(I − M)⁻¹ M` by LU with partial pivoting in f32, and its estimated relative error (module
-/// notes).
-pub fn infinite_f32(m: &Mat<f32>, rows: RowMajor) -> Result<(Mat<f32>, f64)> {
-    let n = m.nrows();
-    let mut a = m.clone();
-    a.par_col_iter_mut().enumerate().for_each(|(j, col)| {
-        let c = col.try_as_col_major_mut().unwrap().as_slice_mut();
-        c.iter_mut().for_each(|v| *v = -*v);
-        c[j] += 1.0;
-    });
-    let lu = a.partial_piv_lu();
-    drop(a);
-    let u = lu.U();
-    check_pivots((0..n).map(|i| u[(i, i)] as f64))?;
-    let mut s = lu.inverse();
-    // Off the diagonal S = (I − M)⁻¹; on it, (I − M)⁻¹ − I would keep only f32's absolute
-    // precision near 1: S_ii = Σ_q (I − M)⁻¹(i, q) M(q, i) instead, in f64 (both operands
-    // read contiguously: columns of the inverse, rows of M).
-    let diag = column_sums(n, n, |q, acc| {
-        let (col, rq) = (s.col_as_slice(q), rows.rho[q] as f64);
-        let fq = &rows.f[q * n..(q + 1) * n];
-        for ((a, &v), &fv) in acc.iter_mut().zip(col).zip(fq) {
-            *a += v as f64 * rq * fv as f64;
-        }
-    });
-    for (i, d) in diag.into_iter().enumerate() {
-        s[(i, i)] = d as f32;
-    }
-    // The largest |S| and the non-finite check, by columns.
-    let top = (0..n)
-        .into_par_iter()
-        .map(|j| {
-            s.col_as_slice(j)
-                .iter()
-                .try_fold(0f64, |a, &v| v.is_finite().then(|| a.max(v.abs() as f64)))
-        })
-        .try_reduce(|| 0f64, |a, b| Some(a.max(b)))
-        .ok_or_else(non_finite)?;
-    // r_j = m_j − s_j + M s_j in f64 for 32 columns, by row blocks.
+/// `max |δ| / max |s|` over 32 columns spread over S (module notes): the 32 right-hand sides
+/// solved together, the residuals in one pass over the rows of F.
+fn error_estimate<T: Real>(lu: &Factored<T>, m: RowMajor) -> f64 {
+    let n = lu.n();
     let k = n.min(32);
     let cols: Vec<usize> = (0..k).map(|c| c * n / k).collect();
-    let st: Vec<f64> = (0..n)
-        .flat_map(|q| cols.iter().map(move |&j| (q, j)))
-        .map(|(q, j)| s[(q, j)] as f64)
-        .collect(); // st[q * k + c] = S(q, cols[c])
-    let mut r = vec![0f64; n * k]; // r[i * k + c]
-    r.par_chunks_mut(BLOCK * k)
-        .enumerate()
-        .for_each(|(b, chunk)| {
-            let i0 = b * BLOCK;
-            let rows = chunk.len() / k;
-            for q in 0..n {
-                let mq = &m.col_as_slice(q)[i0..i0 + rows];
-                let sq = &st[q * k..(q + 1) * k];
-                for (di, &mi) in mq.iter().enumerate() {
-                    if mi != 0.0 {
-                        let mi = mi as f64;
-                        for (acc, &x) in chunk[di * k..(di + 1) * k].iter_mut().zip(sq) {
-                            *acc += mi * x;
-                        }
-                    }
+    // mj[i·k + c] = M(i, cols[c])
+    let mj: Vec<f64> = (0..n)
+        .flat_map(|i| cols.iter().map(move |&j| (i, j)))
+        .map(|(i, j)| m.rho[i] as f64 * m.f_row(i)[j] as f64)
+        .collect();
+    let s = lu.solve_many(&mj, k);
+    // r = m_j − s + M s in f64, by rows.
+    let mut r = vec![0f64; n * k];
+    r.par_chunks_mut(k).enumerate().for_each(|(i, ri)| {
+        let mut acc = vec![0f64; k];
+        for (q, &fv) in m.f_row(i).iter().enumerate() {
+            if fv != 0.0 {
+                for (a, &x) in acc.iter_mut().zip(&s[q * k..(q + 1) * k]) {
+                    *a += fv as f64 * x;
                 }
             }
-            for di in 0..rows {
-                for (c, &j) in cols.iter().enumerate() {
-                    chunk[di * k + c] += m[(i0 + di, j)] as f64 - s[(i0 + di, j)] as f64;
-                }
-            }
-        });
-    let mut delta = Mat::<f32>::from_fn(n, k, |i, c| r[i * k + c] as f32);
-    lu.solve_in_place(delta.as_mut());
-    let mut worst = 0f64;
-    for c in 0..k {
-        for i in 0..n {
-            worst = worst.max((delta[(i, c)] as f64).abs());
         }
-    }
-    // Clamp rounding noise around exact zeros (S is non-negative in exact arithmetic).
-    s.par_col_iter_mut().for_each(|col| {
-        let c = col.try_as_col_major_mut().unwrap().as_slice_mut();
-        c.iter_mut().for_each(|v| *v = v.max(0.0));
+        for c in 0..k {
+            ri[c] = mj[i * k + c] - s[i * k + c] + m.rho[i] as f64 * acc[c];
+        }
     });
-    let err = match worst / top.max(f64::MIN_POSITIVE) {
+    let delta = lu.solve_many(&r, k);
+    let fold = |v: &[f64]| v.iter().fold(0f64, |a, x| a.max(x.abs()));
+    match fold(&delta) / fold(&s).max(f64::MIN_POSITIVE) {
         e if e.is_finite() => e,
         _ => f64::INFINITY,
-    };
-    Ok((s, err))
+    }
 }
 
 /// The column-major matrix `f(i, j)` (i, j < n), filled by column blocks in parallel with
@@ -300,17 +233,43 @@ pub fn to_row_major(s: &Mat<f32>) -> Vec<f32> {
 /// parallel, summed in f64 in the same order whatever the thread count.
 pub fn spectral_bounds(m: &Mat<f32>, enough_below: Option<f64>) -> (f64, f64) {
     let n = m.nrows();
-    let mut x = vec![1f64; n];
-    let mut bounds: (f64, f64) = (0.0, f64::INFINITY);
-    for _ in 0..64 {
-        let y = column_sums(n, n, |j, acc| {
+    bounds_by(n, enough_below, |x| {
+        column_sums(n, n, |j, acc| {
             let xj = x[j];
             if xj != 0.0 {
                 for (yi, &v) in acc.iter_mut().zip(m.col_as_slice(j)) {
                     *yi += v as f64 * xj;
                 }
             }
-        });
+        })
+    })
+}
+
+/// [`spectral_bounds`] of M given by rows (each product by rows in parallel, each row summed in
+/// order: deterministic), without building the column-major M.
+pub fn spectral_bounds_rows(m: RowMajor, enough_below: Option<f64>) -> (f64, f64) {
+    let n = m.rho.len();
+    bounds_by(n, enough_below, |x| {
+        (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let s: f64 = m.f_row(i).iter().zip(x).map(|(&f, &v)| f as f64 * v).sum();
+                m.rho[i] as f64 * s
+            })
+            .collect()
+    })
+}
+
+/// The power iteration of [`spectral_bounds`] with the product `y = M x` given.
+fn bounds_by(
+    n: usize,
+    enough_below: Option<f64>,
+    product: impl Fn(&[f64]) -> Vec<f64>,
+) -> (f64, f64) {
+    let mut x = vec![1f64; n];
+    let mut bounds: (f64, f64) = (0.0, f64::INFINITY);
+    for _ in 0..64 {
+        let y = product(&x);
         let (mut lo, mut hi) = (f64::INFINITY, 0f64);
         for i in 0..n {
             if x[i] > 0.0 {

@@ -22,6 +22,7 @@ pub mod formfactor;
 pub mod geometry;
 pub mod infinite;
 pub mod locate;
+pub mod lu_panels;
 pub mod matrix;
 pub mod objects;
 pub mod overlap;

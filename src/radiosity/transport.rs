@@ -17,7 +17,7 @@
 //! albedo 1 never loses energy — instead of returning huge or NaN entries.
 
 use super::infinite::{from_fn_tiled, infinite, to_row_major, RowMajor, F32_BYTES_PER_ENTRY};
-pub use super::infinite::{spectral_bounds, InfiniteSolver, F32_ACCEPT};
+pub use super::infinite::{spectral_bounds, spectral_bounds_rows, InfiniteSolver, F32_ACCEPT};
 use super::TransportMatrix;
 use crate::error::{Error, Result};
 use crate::limits;
@@ -146,6 +146,25 @@ pub fn transport(
     progress.begin("transport", channels as u64);
     for c in 0..channels {
         let rho: Vec<f32> = albedo.iter().map(|a| a[c]).collect();
+        let rows = RowMajor { f, rho: &rho };
+        if params.bounces == Bounces::Infinite {
+            let bounds = infinite_bounds(rows)?;
+            out.spectral_bounds.push(bounds);
+            let n2 = (n * n) as u64;
+            let check = |bytes: u64, why: String| {
+                limits::check_memory(
+                    &why,
+                    n2 * 4 + channels as u64 * n2 * 4 + bytes,
+                    params.max_memory,
+                )
+            };
+            let (s, solver, err) = infinite(rows, params.solver, &check)?;
+            out.solvers.push((solver, err));
+            out.bounces.push(0);
+            values.extend(s);
+            progress.advance(1);
+            continue;
+        }
         let m = from_fn_tiled(n, |i, j| rho[i] * f[i * n + j]);
         let (s, k, products) = match params.bounces {
             Bounces::Finite(k) => {
@@ -158,26 +177,7 @@ pub fn transport(
                 refuse_divergent(bounds, "Auto")?;
                 auto_sum(&m, tol)?
             }
-            Bounces::Infinite => {
-                // Only the refusal needs the bound here: once the largest row sum of M is
-                // below 1 − margin (every albedo below 1 and rows summing to at most 1), the
-                // spectral radius is too, and the power iteration stops after its first step.
-                let bounds = spectral_bounds(&m, Some(1.0 - SPECTRAL_MARGIN));
-                out.spectral_bounds.push(bounds);
-                refuse_divergent(bounds, "Infinite")?;
-                let n2 = (n * n) as u64;
-                let check = |bytes: u64, why: String| {
-                    limits::check_memory(
-                        &why,
-                        n2 * 4 + channels as u64 * n2 * 4 + bytes,
-                        params.max_memory,
-                    )
-                };
-                let rows = RowMajor { f, rho: &rho };
-                let (s, solver, err) = infinite(&m, rows, params.solver, &check)?;
-                out.solvers.push((solver, err));
-                (s, 0, 0)
-            }
+            Bounces::Infinite => unreachable!("solved above"),
         };
         out.bounces.push(k);
         out.products += products;
@@ -187,6 +187,15 @@ pub fn transport(
     progress.finish();
     out.matrix = TransportMatrix::new(channels, n, values)?;
     Ok(out)
+}
+
+/// The spectral bounds of M for infinite bounces, refusing a divergent M. Only the refusal needs
+/// them: once the largest row sum of M is below 1 − margin (every albedo below 1 and rows summing
+/// to at most 1), the spectral radius is too, and the power iteration stops after its first step.
+pub fn infinite_bounds(rows: RowMajor) -> Result<(f64, f64)> {
+    let bounds = spectral_bounds_rows(rows, Some(1.0 - SPECTRAL_MARGIN));
+    refuse_divergent(bounds, "Infinite")?;
+    Ok(bounds)
 }
 
 fn refuse_divergent(bounds: (f64, f64), what: &str) -> Result<()> {
