@@ -16,29 +16,48 @@ use crate::progress::Progress;
 use crate::radiosity::geometry::{cosine_direction, item_rng};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Estimate F with `samples` rays per patch; patch i uses the random stream `(seed, i)`.
 pub fn estimate(ctx: &Context, samples: u32, seed: u64, progress: &dyn Progress) -> FormFactors {
     let n = ctx.samplers.len();
-    let k = samples as usize;
-    let unassigned = AtomicU64::new(0);
-    let mut values = vec![0f32; n * n];
-    progress.begin("form factors (hemisphere)", n as u64);
-    values.par_chunks_mut(n).enumerate().for_each(|(i, row)| {
-        let counts = shoot(ctx, i, k, seed, &unassigned);
-        for (r, c) in row.iter_mut().zip(counts) {
-            *r = (c as f64 / k as f64) as f32;
-        }
-        progress.advance(1);
-    });
-    progress.finish();
+    let (values, unassigned) = estimate_rows(ctx, 0..n, samples, seed, progress);
     FormFactors {
         n,
         values,
-        rays: n as u64 * k as u64,
-        unassigned_hits: unassigned.into_inner(),
+        rays: n as u64 * samples as u64,
+        unassigned_hits: unassigned,
     }
+}
+
+/// Rows `rows` of F (`[rows.len(), n]` row-major) and the hits that found no patch: each row is
+/// a function of (scene, patches, samples, seed, its index) alone, so rows computed by
+/// different processes assemble into the matrix [`estimate`] makes.
+pub fn estimate_rows(
+    ctx: &Context,
+    rows: Range<usize>,
+    samples: u32,
+    seed: u64,
+    progress: &dyn Progress,
+) -> (Vec<f32>, u64) {
+    let n = ctx.samplers.len();
+    let k = samples as usize;
+    let unassigned = AtomicU64::new(0);
+    let mut values = vec![0f32; rows.len() * n];
+    progress.begin("form factors (hemisphere)", rows.len() as u64);
+    values
+        .par_chunks_mut(n.max(1))
+        .enumerate()
+        .for_each(|(r, row)| {
+            let counts = shoot(ctx, rows.start + r, k, seed, &unassigned);
+            for (v, c) in row.iter_mut().zip(counts) {
+                *v = (c as f64 / k as f64) as f32;
+            }
+            progress.advance(1);
+        });
+    progress.finish();
+    (values, unassigned.into_inner())
 }
 
 /// The `k` rays patch `i` shoots (grid coordinates): origins lifted one ray epsilon off the

@@ -27,6 +27,7 @@ use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
+use std::ops::Range;
 
 /// Which form-factor estimator to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -113,21 +114,171 @@ pub fn form_factors(
     params: &FormFactorParams,
     progress: &dyn Progress,
 ) -> Result<FormFactors> {
+    check(set, params)?;
+    let ctx = Context::new(scene, set);
+    let rows = form_factor_rows_with(&ctx, params, 0..set.len(), progress);
+    let areas: Vec<f64> = ctx.samplers.iter().map(|s| s.area).collect();
+    Ok(assemble_with(&areas, params, &[rows]))
+}
+
+/// A contiguous block of rows of the raw estimate, computed alone (one shard of a bake): the
+/// hemisphere's rows of F before reciprocity averaging, or the pairwise estimator's rows of
+/// the upper triangle of the throughput. [`assemble`] turns a complete set into what
+/// [`form_factors`] returns, byte for byte.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RowBlock {
+    /// `[rows.len(), n]` f32 rows of F (hits / N) and the hits that found no patch.
+    Hemisphere {
+        rows: Range<usize>,
+        values: Vec<f32>,
+        unassigned: u64,
+    },
+    /// Row i holds `A_i F_ij` for j = i..n, rows concatenated.
+    Pairwise { rows: Range<usize>, upper: Vec<f64> },
+}
+
+impl RowBlock {
+    pub fn rows(&self) -> Range<usize> {
+        match self {
+            RowBlock::Hemisphere { rows, .. } | RowBlock::Pairwise { rows, .. } => rows.clone(),
+        }
+    }
+}
+
+/// The rows of shard `index` of `count`: equal row counts for the hemisphere estimators (every
+/// row costs N rays), equal pair counts for the pairwise one (row i has n − i pairs).
+pub fn shard_rows(estimator: Estimator, n: usize, index: usize, count: usize) -> Range<usize> {
+    match estimator {
+        Estimator::Pairwise => {
+            pairwise::balanced_row(n, index, count)..pairwise::balanced_row(n, index + 1, count)
+        }
+        _ => index * n / count..(index + 1) * n / count,
+    }
+}
+
+/// Rows `rows` of the raw estimate (see [`RowBlock`]).
+pub fn form_factor_rows(
+    scene: &Scene,
+    set: &PatchSet,
+    params: &FormFactorParams,
+    rows: Range<usize>,
+    progress: &dyn Progress,
+) -> Result<RowBlock> {
+    check(set, params)?;
+    if rows.end > set.len() || rows.start > rows.end {
+        return Err(Error::Internal(format!(
+            "form factor rows {rows:?} of {} patches",
+            set.len()
+        )));
+    }
+    let ctx = Context::new(scene, set);
+    Ok(form_factor_rows_with(&ctx, params, rows, progress))
+}
+
+/// The form factors from blocks that cover rows 0..n in order (the blocks of every shard).
+pub fn assemble(
+    set: &PatchSet,
+    params: &FormFactorParams,
+    blocks: &[RowBlock],
+) -> Result<FormFactors> {
+    check(set, params)?;
+    let mut next = 0;
+    for b in blocks {
+        let ok = match b {
+            RowBlock::Hemisphere { rows, values, .. } => {
+                params.estimator != Estimator::Pairwise && values.len() == rows.len() * set.len()
+            }
+            RowBlock::Pairwise { rows, upper } => {
+                let n = set.len();
+                params.estimator == Estimator::Pairwise
+                    && upper.len() == rows.clone().map(|i| n - i).sum::<usize>()
+            }
+        };
+        if !ok || b.rows().start != next {
+            return Err(Error::Internal(format!(
+                "form factor blocks do not cover the {} rows in order",
+                set.len()
+            )));
+        }
+        next = b.rows().end;
+    }
+    if next != set.len() {
+        return Err(Error::Internal(format!(
+            "form factor blocks end at row {next} of {}",
+            set.len()
+        )));
+    }
+    let areas: Vec<f64> = set.patches.iter().map(|p| piece_sampler(set, p).area).collect();
+    Ok(assemble_with(&areas, params, blocks))
+}
+
+fn check(set: &PatchSet, params: &FormFactorParams) -> Result<()> {
     if params.samples == 0 {
         return Err(Error::knob("form_factors: samples must be at least 1"));
     }
     if set.is_empty() {
         return Err(Error::input("patches", "no patches"));
     }
-    let ctx = Context::new(scene, set);
-    Ok(match params.estimator {
-        Estimator::Hemisphere => hemisphere::estimate(&ctx, params.samples, params.seed, progress),
-        Estimator::HemisphereReciprocal => {
-            let mut f = hemisphere::estimate(&ctx, params.samples, params.seed, progress);
-            let areas: Vec<f64> = ctx.samplers.iter().map(|s| s.area).collect();
-            reciprocal::average(&mut f.values, &areas);
-            f
+    Ok(())
+}
+
+fn form_factor_rows_with(
+    ctx: &Context,
+    params: &FormFactorParams,
+    rows: Range<usize>,
+    progress: &dyn Progress,
+) -> RowBlock {
+    match params.estimator {
+        Estimator::Hemisphere | Estimator::HemisphereReciprocal => {
+            let (values, unassigned) =
+                hemisphere::estimate_rows(ctx, rows.clone(), params.samples, params.seed, progress);
+            RowBlock::Hemisphere {
+                rows,
+                values,
+                unassigned,
+            }
         }
-        Estimator::Pairwise => pairwise::estimate(&ctx, params.samples, params.seed, progress),
-    })
+        Estimator::Pairwise => RowBlock::Pairwise {
+            upper: pairwise::upper_rows(ctx, rows.clone(), params.samples, params.seed, progress),
+            rows,
+        },
+    }
+}
+
+/// Blocks (checked to cover every row in order) → F.
+fn assemble_with(areas: &[f64], params: &FormFactorParams, blocks: &[RowBlock]) -> FormFactors {
+    let n = areas.len();
+    if params.estimator == Estimator::Pairwise {
+        let upper: Vec<f64> = blocks
+            .iter()
+            .flat_map(|b| match b {
+                RowBlock::Pairwise { upper, .. } => upper.as_slice(),
+                RowBlock::Hemisphere { .. } => &[],
+            })
+            .copied()
+            .collect();
+        return pairwise::assemble(areas, &upper, params.samples);
+    }
+    let mut values = Vec::with_capacity(n * n);
+    let mut unassigned_hits = 0;
+    for b in blocks {
+        if let RowBlock::Hemisphere {
+            values: v,
+            unassigned,
+            ..
+        } = b
+        {
+            values.extend_from_slice(v);
+            unassigned_hits += unassigned;
+        }
+    }
+    if params.estimator == Estimator::HemisphereReciprocal {
+        reciprocal::average(&mut values, areas);
+    }
+    FormFactors {
+        n,
+        values,
+        rays: n as u64 * params.samples as u64,
+        unassigned_hits,
+    }
 }

@@ -22,6 +22,7 @@ use crate::progress::Progress;
 use crate::radiosity::geometry::{item_rng, point_to_triangle, AreaSampler, Rng};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Cosines at or below this count as zero (grazing, coplanar, facing away).
 const MIN_COSINE: f64 = 1e-6;
@@ -30,10 +31,25 @@ const MIN_COSINE: f64 = 1e-6;
 /// `(seed, i, j)`.
 pub fn estimate(ctx: &Context, samples: u32, seed: u64, progress: &dyn Progress) -> FormFactors {
     let n = ctx.samplers.len();
+    let upper = upper_rows(ctx, 0..n, samples, seed, progress);
+    let areas: Vec<f64> = ctx.samplers.iter().map(|s| s.area).collect();
+    assemble(&areas, &upper, samples)
+}
+
+/// Rows `rows` of the upper triangle of the throughput, concatenated: row i holds
+/// `A_i F_ij` for j = i..n (grid units²). Each pair is a function of (scene, patches, samples,
+/// seed, i, j) alone.
+pub fn upper_rows(
+    ctx: &Context,
+    rows: Range<usize>,
+    samples: u32,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Vec<f64> {
+    let n = ctx.samplers.len();
     let k = samples as usize;
-    progress.begin("form factors (pairwise)", n as u64);
-    // Upper triangle rows: g[i][j - i] = A_i F_ij (grid units²).
-    let upper: Vec<Vec<f64>> = (0..n)
+    progress.begin("form factors (pairwise)", rows.len() as u64);
+    let upper: Vec<Vec<f64>> = rows
         .into_par_iter()
         .map(|i| {
             let row = (i..n).map(|j| throughput(ctx, i, j, k, seed)).collect();
@@ -42,13 +58,19 @@ pub fn estimate(ctx: &Context, samples: u32, seed: u64, progress: &dyn Progress)
         })
         .collect();
     progress.finish();
+    upper.concat()
+}
+
+/// F from the whole upper triangle (rows 0..n of [`upper_rows`], concatenated).
+pub fn assemble(areas: &[f64], upper: &[f64], samples: u32) -> FormFactors {
+    let n = areas.len();
     let mut values = vec![0f32; n * n];
-    let mut rays = 0u64;
-    for (i, row) in upper.iter().enumerate() {
-        let ai = ctx.samplers[i].area;
-        for (d, &g) in row.iter().enumerate() {
+    let mut at = 0;
+    for i in 0..n {
+        let ai = areas[i];
+        for (d, &g) in upper[at..at + n - i].iter().enumerate() {
             let j = i + d;
-            let aj = ctx.samplers[j].area;
+            let aj = areas[j];
             if ai > 0.0 {
                 values[i * n + j] = (g / ai) as f32;
             }
@@ -56,14 +78,26 @@ pub fn estimate(ctx: &Context, samples: u32, seed: u64, progress: &dyn Progress)
                 values[j * n + i] = (g / aj) as f32;
             }
         }
-        rays += (row.len() * points_per_patch(k).pow(2)) as u64;
+        at += n - i;
     }
+    let pairs = (n * (n + 1) / 2) as u64;
     FormFactors {
         n,
         values,
-        rays,
+        rays: pairs * points_per_patch(samples as usize).pow(2) as u64,
         unassigned_hits: 0,
     }
+}
+
+/// The first row of shard `index` of `count` when rows are split so that each shard gets about
+/// the same number of pairs (row i has n − i).
+pub fn balanced_row(n: usize, index: usize, count: usize) -> usize {
+    let total = (n * (n + 1) / 2) as f64;
+    let want = total * index as f64 / count as f64;
+    // Pairs before row r: r·n − r(r − 1)/2; the first r whose count reaches `want`.
+    (0..=n)
+        .find(|&r| (r * n) as f64 - (r * r.saturating_sub(1)) as f64 / 2.0 >= want)
+        .unwrap_or(n)
 }
 
 /// Points per patch for `samples` pairs: `m = ⌊√samples⌋`, giving `m²` pairs.
