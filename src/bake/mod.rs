@@ -4,6 +4,7 @@
 pub mod cache;
 pub mod estimate;
 pub mod plan;
+pub mod shard;
 pub mod stages;
 pub mod workspace;
 
@@ -16,7 +17,9 @@ use crate::limits;
 use crate::load::{load_input, LoadedInput};
 use crate::pipeline::{Pipeline, Stage};
 use crate::progress::Progress;
+use crate::baked::shard::ShardHeader;
 use cache::StageCache;
+pub use shard::{ShardWritten, Sharding};
 use serde::Serialize;
 use stages::runner;
 use std::path::{Path, PathBuf};
@@ -34,6 +37,8 @@ pub struct BakeOptions {
     /// Run every stage even when the output is up to date or the cache holds them (the cache is
     /// refreshed with what runs).
     pub force: bool,
+    /// Bake whole, compute one shard, or merge shards (docs/scale-out.md).
+    pub sharding: Sharding,
 }
 
 impl Default for BakeOptions {
@@ -42,6 +47,7 @@ impl Default for BakeOptions {
             max_memory: limits::default_max_memory(),
             cache: None,
             force: false,
+            sharding: Sharding::Whole,
         }
     }
 }
@@ -61,6 +67,12 @@ pub struct BakeReport {
     pub estimated_peak_bytes: u64,
     /// The process's measured peak resident memory (Linux), for comparison with the estimate.
     pub peak_rss_bytes: Option<u64>,
+    /// `run --shard`: the shard this process wrote (nothing else was written).
+    pub shard: Option<ShardWritten>,
+    /// `merge`: the stage whose shards are still to be computed (a next round of
+    /// `run --shard`); the stages merged so far are kept in the stage cache, the output is not
+    /// written yet.
+    pub needs_shards: Option<String>,
 }
 
 /// Wall time and outputs of one stage.
@@ -92,6 +104,10 @@ pub fn run_pipeline(
 ) -> Result<BakeReport> {
     let t0 = Instant::now();
     limits::baseline_rss();
+    let merge_set = match &opts.sharding {
+        Sharding::Merge { dirs } => Some(shard::ShardSet::scan(dirs)?),
+        _ => None,
+    };
     progress.begin("load", 0);
     let input = load_input(&pipeline.input)?;
     progress.finish();
@@ -138,16 +154,81 @@ pub fn run_pipeline(
         let (rec, cached) = match hit {
             Some(hit) => (hit.apply(&mut txn)?, true),
             None => {
+                let sharding = match &opts.sharding {
+                    Sharding::Shard { index, count, .. } => Some((*index, *count)),
+                    _ => None,
+                };
+                if sharding.is_some() && !pipeline.stages[i..].iter().any(|s| runner(s).shardable()) {
+                    // Every shardable stage is in the cache: the rest is the merge's.
+                    return Ok(partial_report(output, timings, warnings, estimated_peak, None, None));
+                }
                 let rest = plan::plan_measured(pipeline, &plan_input, output, &measured);
-                // The first stage that runs answers for the load too.
-                let peak = rest.peak_from(if ran_any { i + 1 } else { 0 });
+                // The first stage that runs answers for the load too; a shard answers for its
+                // own part only.
+                let peak = match sharding {
+                    Some((index, count)) if runner(stage).shardable() => plan::shard_peak(
+                        pipeline, &plan_input, &measured, i, index, count,
+                    ),
+                    _ => rest.peak_from(if ran_any { i + 1 } else { 0 }),
+                };
                 ran_any = true;
                 let what = format!("the rest of this bake (from `{}`)", stage.kind().name());
                 limits::check_memory(&what, peak, opts.max_memory)?;
                 estimated_peak = estimated_peak.max(peak);
                 stage_estimate = rest.stages[i + 1].peak_bytes;
                 limits::reset_peak_rss();
-                let rec = runner(stage).run(&mut ws, &mut txn, progress)?;
+                let run = runner(stage);
+                let name = stage.kind().name();
+                let rec = match (&opts.sharding, run.shardable()) {
+                    (Sharding::Shard { index, count, dir }, true) => {
+                        if cache.is_none() {
+                            return Err(Error::knob(
+                                "--shard needs the stage cache (drop --no-cache): the merge and the next round of shards find the stages all shards share there",
+                            ));
+                        }
+                        let (part, payload) = run.run_shard(&mut ws, *index, *count, progress)?;
+                        let header = ShardHeader {
+                            bake: shard::bake_id(pipeline)?,
+                            stage: name.into(),
+                            index: *index as u32,
+                            count: *count as u32,
+                            key: key.clone(),
+                            relume_version: env!("CARGO_PKG_VERSION").into(),
+                            pipeline: pipeline.clone(),
+                            part: part.clone(),
+                            facts: Default::default(),
+                            sections: Vec::new(),
+                            payload_bytes: 0,
+                            payload_sha256: String::new(),
+                        };
+                        let path = crate::baked::shard::write(dir, header, &payload)?;
+                        let mut tm = timing(&records[0], t, false);
+                        tm.stage = name.into();
+                        tm.outputs = vec![path.display().to_string()];
+                        tm.peak_rss_bytes = limits::peak_rss();
+                        timings.push(tm);
+                        return Ok(partial_report(output, timings, warnings, estimated_peak, Some(ShardWritten {
+                            stage: name.into(),
+                            index: *index,
+                            count: *count,
+                            part,
+                            path,
+                        }), None));
+                    }
+                    (Sharding::Merge { .. }, true) => {
+                        let set = merge_set.as_ref().expect("scanned for a merge");
+                        let Some(paths) = set.complete(name, &key)? else {
+                            return Ok(partial_report(output, timings, warnings, estimated_peak, None, Some(name.into())));
+                        };
+                        let mut shards = Vec::with_capacity(paths.len());
+                        for p in paths {
+                            let (_, payload) = crate::baked::shard::read(&p)?;
+                            shards.push((p, payload));
+                        }
+                        run.merge_shards(&mut ws, &mut txn, shards)?
+                    }
+                    _ => run.run(&mut ws, &mut txn, progress)?,
+                };
                 if let Some(c) = &cache {
                     if let Err(e) = c.store(&key, stage, &rec, &before, &txn) {
                         let w = format!("the stage cache is not kept: {e}");
@@ -169,6 +250,10 @@ pub fn run_pipeline(
         records.push(rec);
     }
 
+    if matches!(opts.sharding, Sharding::Shard { .. }) {
+        // Every stage was in the cache: nothing to shard, the output is the merge's to write.
+        return Ok(partial_report(output, timings, warnings, estimated_peak, None, None));
+    }
     let (bytes, sha256) = hash_file(pipeline.input.path())?;
     let input_name = pipeline
         .input
@@ -210,7 +295,32 @@ pub fn run_pipeline(
         warnings,
         estimated_peak_bytes: estimated_peak,
         peak_rss_bytes: peak_rss,
+        shard: None,
+        needs_shards: None,
     })
+}
+
+/// The report of a bake that stopped before its commit on purpose: a shard was written, or a
+/// merge needs the next round of shards.
+fn partial_report(
+    output: &Path,
+    stages: Vec<StageTiming>,
+    warnings: Vec<String>,
+    estimated_peak_bytes: u64,
+    shard: Option<ShardWritten>,
+    needs_shards: Option<String>,
+) -> BakeReport {
+    BakeReport {
+        output: output.to_path_buf(),
+        up_to_date: false,
+        peak_rss_bytes: stages.iter().filter_map(|t| t.peak_rss_bytes).max(),
+        stages,
+        files: Vec::new(),
+        warnings,
+        estimated_peak_bytes,
+        shard,
+        needs_shards,
+    }
 }
 
 /// Does the baked directory at `output` have exactly this manifest, with every file intact? A
@@ -390,5 +500,7 @@ pub fn run_stage_on_with(
         warnings: Vec::new(),
         estimated_peak_bytes: 0,
         peak_rss_bytes: limits::peak_rss(),
+        shard: None,
+        needs_shards: None,
     })
 }

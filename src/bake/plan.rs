@@ -170,3 +170,86 @@ fn estimate(stage: &Stage, state: &mut PlanState) -> PlannedStage {
     planned.peak_bytes += resident;
     planned
 }
+
+/// Estimated peak bytes of shard `index` of `count` of the stage at `stage_index` (a shardable
+/// one): what earlier stages keep resident plus the shard's own working memory.
+pub fn shard_peak(
+    pipeline: &Pipeline,
+    input: &PlanInput,
+    measured: &Measured,
+    stage_index: usize,
+    index: usize,
+    count: usize,
+) -> u64 {
+    let mut state = input.state.clone();
+    state.measured_patches = measured.patches;
+    for stage in &pipeline.stages[..stage_index] {
+        estimate(stage, &mut state);
+    }
+    let stage = &pipeline.stages[stage_index];
+    // The stage's own estimate sets the sizes it depends on (patches, channels).
+    let resident = state.resident_bytes;
+    let mut after = state.clone();
+    runner(stage).estimate(&mut after);
+    resident + runner(stage).estimate_shard(&after, index, count) + crate::limits::baseline_rss()
+}
+
+/// Per-shard and merge estimates for a bake split `count` ways (`plan --shards N`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ShardPlan {
+    /// Rounds of shards, one per shardable stage, in order.
+    pub rounds: Vec<ShardRound>,
+    /// Estimated peak of a merge (the stages that are not split, and the assembly of each
+    /// round's shards).
+    pub merge_peak_bytes: u64,
+}
+
+/// One shardable stage split `count` ways.
+#[derive(Clone, Debug, Serialize)]
+pub struct ShardRound {
+    pub stage: String,
+    pub count: usize,
+    /// The largest estimated peak of one shard.
+    pub shard_peak_bytes: u64,
+    /// The largest estimated shard file.
+    pub shard_bytes: u64,
+}
+
+/// Plan a bake split into `count` shards per shardable stage.
+pub fn plan_shards(
+    pipeline: &Pipeline,
+    input: &PlanInput,
+    measured: &Measured,
+    count: usize,
+) -> ShardPlan {
+    let base = crate::limits::baseline_rss();
+    let mut state = input.state.clone();
+    state.measured_patches = measured.patches;
+    let mut rounds = Vec::new();
+    let mut merge_peak = input.load.peak_bytes + base;
+    for (i, stage) in pipeline.stages.iter().enumerate() {
+        let resident = state.resident_bytes;
+        let planned = estimate(stage, &mut state);
+        if !runner(stage).shardable() {
+            merge_peak = merge_peak.max(planned.peak_bytes + base);
+            continue;
+        }
+        let peak = (0..count)
+            .map(|k| shard_peak(pipeline, input, measured, i, k, count))
+            .max()
+            .unwrap_or(0);
+        // The merge holds what earlier stages keep, the assembled output and its working copy
+        // (the reciprocity average copies F) or the shard being read.
+        merge_peak = merge_peak.max(resident + 2 * planned.output_bytes + base);
+        rounds.push(ShardRound {
+            stage: stage.kind().name().into(),
+            count,
+            shard_peak_bytes: peak,
+            shard_bytes: planned.output_bytes.div_ceil(count as u64) + 4096,
+        });
+    }
+    ShardPlan {
+        rounds,
+        merge_peak_bytes: merge_peak,
+    }
+}

@@ -3,6 +3,7 @@
 //! (when one stage runs alone on a baked directory) are read from disk on first use, through
 //! the `crate::baked` module of their file.
 
+use crate::baked::form_factors::MappedFormFactors;
 use crate::baked::{self, form_factors::FormFactorMatrix, Manifest};
 use crate::compress::EncodedTransport;
 use crate::error::{Error, Result};
@@ -11,6 +12,29 @@ use crate::radiosity::{PatchSet, TransportMatrix};
 use crate::scene::Scene;
 use crate::terrain::MinMaxMipmap;
 use std::path::{Path, PathBuf};
+
+/// The form factors, in memory or mapped from a file.
+pub enum FormFactorView<'a> {
+    Owned(&'a FormFactorMatrix),
+    Mapped(MappedFormFactors),
+}
+
+impl FormFactorView<'_> {
+    pub fn n(&self) -> usize {
+        match self {
+            FormFactorView::Owned(f) => f.n,
+            FormFactorView::Mapped(m) => m.n,
+        }
+    }
+
+    /// `[n, n]` row-major F.
+    pub fn values(&self) -> &[f32] {
+        match self {
+            FormFactorView::Owned(f) => &f.values,
+            FormFactorView::Mapped(m) => m.values(),
+        }
+    }
+}
 
 /// In-memory artifacts of a bake.
 #[derive(Default)]
@@ -101,6 +125,18 @@ impl Workspace {
             self.heightmap = Some(baked::heightmap::read(&dir, manifest)?);
         }
         Ok(self.heightmap.as_ref().unwrap())
+    }
+
+    /// The form factors without copying them: borrowed when this run made or read them, else
+    /// memory-mapped from the source bake's file (a transport shard reads F once to factor it).
+    pub fn form_factors_mapped(&mut self) -> Result<FormFactorView<'_>> {
+        if let Some(f) = &self.form_factors {
+            return Ok(FormFactorView::Owned(f));
+        }
+        let dir = self.require_source(baked::form_factors::FILE)?;
+        Ok(FormFactorView::Mapped(MappedFormFactors::open(
+            &dir.join(baked::form_factors::FILE),
+        )?))
     }
 
     /// The transport, to be changed in place and restored (the bounded reorder transposes it).

@@ -22,6 +22,7 @@ pub mod npy;
 pub mod patches;
 pub mod permutation;
 pub mod scene;
+pub mod shard;
 pub(crate) mod transaction;
 pub mod transport;
 

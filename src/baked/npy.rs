@@ -94,6 +94,16 @@ pub fn parse_npy_f32(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<f32>), 
 
 /// Parse the bytes of a `.npy` file of `T` (see [`read_npy_f32`]); the error is a message.
 pub fn parse_npy<T: NpyElement>(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<T>), String> {
+    let (shape, offset) = parse_npy_header::<T>(bytes)?;
+    let values = bytes[offset..].chunks_exact(T::SIZE).map(T::from_le).collect();
+    Ok((shape, values))
+}
+
+/// The shape of a `.npy` file of `T` and the offset of its data, checked to fill the rest of
+/// `bytes` exactly (see [`read_npy_f32`]).
+pub fn parse_npy_header<T: NpyElement>(
+    bytes: &[u8],
+) -> std::result::Result<(Vec<u64>, usize), String> {
     let bad = |m: &str| format!("not a .npy file: {m}");
     if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
         return Err(bad("missing the \\x93NUMPY magic"));
@@ -165,8 +175,7 @@ pub fn parse_npy<T: NpyElement>(bytes: &[u8]) -> std::result::Result<(Vec<u64>, 
             data.len()
         )));
     }
-    let values = data.chunks_exact(T::SIZE).map(T::from_le).collect();
-    Ok((shape, values))
+    Ok((shape, start + len))
 }
 
 #[cfg(test)]

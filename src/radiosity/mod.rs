@@ -28,6 +28,7 @@ pub mod objects;
 pub mod overlap;
 pub mod reference;
 pub mod transport;
+pub mod transport_shard;
 pub mod visibility;
 pub mod voxel_size;
 pub mod voxelize;

@@ -8,7 +8,9 @@ mod terrain;
 
 use super::estimate::{PlanState, PlannedStage};
 use super::workspace::Workspace;
+use crate::baked::shard::Payload;
 use crate::baked::{BakeTransaction, StageRecord};
+use std::path::PathBuf;
 use crate::error::Result;
 use crate::pipeline::Stage;
 use crate::progress::Progress;
@@ -26,6 +28,38 @@ pub trait StageRun {
 
     /// Estimate peak memory and output bytes, updating `state` for later stages.
     fn estimate(&self, state: &mut PlanState) -> PlannedStage;
+
+    /// Can this stage (with these knobs) be split into shards? (docs/scale-out.md)
+    fn shardable(&self) -> bool {
+        false
+    }
+
+    /// Compute shard `index` of `count`: what part it is (for people), and its arrays.
+    fn run_shard(
+        &self,
+        _ws: &mut Workspace,
+        _index: usize,
+        _count: usize,
+        _progress: &dyn Progress,
+    ) -> Result<(String, Payload)> {
+        Err(crate::error::Error::Internal("this stage has no shards".into()))
+    }
+
+    /// Put every shard's arrays (in index order) together, write the stage's files into `txn`
+    /// as [`StageRun::run`] would, and return the same record.
+    fn merge_shards(
+        &self,
+        _ws: &mut Workspace,
+        _txn: &mut BakeTransaction,
+        _shards: Vec<(PathBuf, Payload)>,
+    ) -> Result<StageRecord> {
+        Err(crate::error::Error::Internal("this stage has no shards".into()))
+    }
+
+    /// Estimated peak bytes of shard `index` of `count` (after `estimate` updated `state`).
+    fn estimate_shard(&self, _state: &PlanState, _index: usize, _count: usize) -> u64 {
+        0
+    }
 }
 
 /// The implementation of a stage.

@@ -7,8 +7,18 @@ use crate::baked::{self, form_factors::FormFactorMatrix, BakeTransaction, StageR
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
 use crate::progress::Progress;
-use crate::radiosity::formfactor::form_factors;
-use crate::radiosity::transport::{memory_estimate, transport, TransportParams};
+use crate::baked::shard::Payload;
+use crate::radiosity::formfactor::{
+    assemble, form_factor_rows, form_factors, shard_rows, Estimator, FormFactors, RowBlock,
+};
+use std::path::PathBuf;
+use crate::radiosity::infinite::InfiniteSolver;
+use crate::radiosity::lu_panels::{panel_count, Panel};
+use crate::radiosity::transport::{memory_estimate, transport, Bounces, Transport, TransportParams};
+use crate::radiosity::transport_shard::{
+    assemble_infinite, channels as transport_channels, infinite_part, part_memory, part_panels,
+    ChannelPart,
+};
 use crate::radiosity::voxelize::{voxelize_noting, Resolution};
 
 impl StageRun for VoxelizeKnobs {
@@ -111,15 +121,126 @@ impl StageRun for FormFactorsKnobs {
     ) -> Result<StageRecord> {
         let budget = ws.memory_budget();
         let (scene, set) = ws.scene_and_patches()?;
-        let n = set.len();
-        let n2 = (n * n) as u64;
-        crate::limits::check_memory(
-            &format!("the form factors of {n} patches"),
-            n2 * 4 * 3,
-            budget,
-        )?;
-        let samples = self.samples();
+        check_form_factor_memory(set.len(), budget)?;
         let f = form_factors(scene, set, &self.params(), progress)?;
+        self.finish(ws, txn, f)
+    }
+
+    fn shardable(&self) -> bool {
+        true
+    }
+
+    fn run_shard(
+        &self,
+        ws: &mut Workspace,
+        index: usize,
+        count: usize,
+        progress: &dyn Progress,
+    ) -> Result<(String, Payload)> {
+        let (scene, set) = ws.scene_and_patches()?;
+        let n = set.len();
+        let rows = shard_rows(self.estimator, n, index, count);
+        let block = form_factor_rows(scene, set, &self.params(), rows.clone(), progress)?;
+        let mut p = Payload::default();
+        p.u64s
+            .insert("rows".into(), vec![rows.start as u64, rows.end as u64]);
+        match block {
+            RowBlock::Hemisphere {
+                values, unassigned, ..
+            } => {
+                p.f32s.insert("values".into(), values);
+                p.u64s.insert("unassigned".into(), vec![unassigned]);
+            }
+            RowBlock::Pairwise { upper, .. } => {
+                p.f64s.insert("upper".into(), upper);
+            }
+        }
+        Ok((format!("rows {}..{} of {n}", rows.start, rows.end), p))
+    }
+
+    fn merge_shards(
+        &self,
+        ws: &mut Workspace,
+        txn: &mut BakeTransaction,
+        shards: Vec<(PathBuf, Payload)>,
+    ) -> Result<StageRecord> {
+        let budget = ws.memory_budget();
+        let set = ws.patches()?;
+        let n = set.len();
+        check_form_factor_memory(n, budget)?;
+        let count = shards.len();
+        let mut blocks = Vec::with_capacity(count);
+        for (i, (path, mut p)) in shards.into_iter().enumerate() {
+            let want = shard_rows(self.estimator, n, i, count);
+            let rows = p.u64s("rows", &path)?;
+            if rows != [want.start as u64, want.end as u64] {
+                return Err(Error::verify(
+                    &path,
+                    format!("holds rows {rows:?}, shard {i} of {count} should hold {want:?}"),
+                ));
+            }
+            let block = if self.estimator == Estimator::Pairwise {
+                RowBlock::Pairwise {
+                    rows: want,
+                    upper: p.f64s("upper", &path)?,
+                }
+            } else {
+                RowBlock::Hemisphere {
+                    rows: want,
+                    values: p.f32s("values", &path)?,
+                    unassigned: p.u64s("unassigned", &path)?.first().copied().unwrap_or(0),
+                }
+            };
+            blocks.push(block);
+        }
+        let f = assemble(set, &self.params(), &blocks)?;
+        drop(blocks);
+        self.finish(ws, txn, f)
+    }
+
+    fn estimate_shard(&self, state: &PlanState, index: usize, count: usize) -> u64 {
+        let n = state.patches as usize;
+        let rows = shard_rows(self.estimator, n, index, count).len() as u64;
+        // Hemisphere rows in f32; pairwise upper rows in f64, at most n entries each.
+        let per_row = state.patches * if self.estimator == Estimator::Pairwise { 8 } else { 4 };
+        state.triangles * 256 + rows * per_row
+    }
+
+    fn estimate(&self, state: &mut PlanState) -> PlannedStage {
+        let n2 = state.patches * state.patches;
+        state.resident_bytes += n2 * 4;
+        PlannedStage {
+            stage: "form_factors".into(),
+            peak_bytes: n2 * 8 + state.triangles * 256,
+            output_bytes: n2 * 4,
+            notes: format!(
+                "{:?}, {} patches: dense [n, n] f32",
+                self.estimator, state.patches
+            ),
+        }
+    }
+}
+
+fn check_form_factor_memory(n: usize, budget: u64) -> Result<()> {
+    crate::limits::check_memory(
+        &format!("the form factors of {n} patches"),
+        (n * n) as u64 * 4 * 3,
+        budget,
+    )
+}
+
+impl FormFactorsKnobs {
+    /// Write F and build the stage's record (shared by `run` and the merge of shards).
+    fn finish(
+        &self,
+        ws: &mut Workspace,
+        txn: &mut BakeTransaction,
+        f: FormFactors,
+    ) -> Result<StageRecord> {
+        let set = ws.patches()?;
+        let n = f.n;
+        let n2 = (n * n) as u64;
+        let samples = self.samples();
         let sums: Vec<f64> = (0..n).map(|i| f.row_sum(i)).collect();
         let matrix = FormFactorMatrix {
             n,
@@ -169,20 +290,6 @@ impl StageRun for FormFactorsKnobs {
         ws.set_form_factors(matrix);
         Ok(rec)
     }
-
-    fn estimate(&self, state: &mut PlanState) -> PlannedStage {
-        let n2 = state.patches * state.patches;
-        state.resident_bytes += n2 * 4;
-        PlannedStage {
-            stage: "form_factors".into(),
-            peak_bytes: n2 * 8 + state.triangles * 256,
-            output_bytes: n2 * 4,
-            notes: format!(
-                "{:?}, {} patches: dense [n, n] f32",
-                self.estimator, state.patches
-            ),
-        }
-    }
 }
 
 impl StageRun for TransportKnobs {
@@ -192,21 +299,11 @@ impl StageRun for TransportKnobs {
         txn: &mut BakeTransaction,
         progress: &dyn Progress,
     ) -> Result<StageRecord> {
-        let set = ws.patches()?;
-        let albedo: Vec<[f32; 3]> = set.patches.iter().map(|p| p.albedo).collect();
-        let n = set.len();
+        let albedo = albedos(ws.patches()?);
+        let n = albedo.len();
         let budget = ws.memory_budget();
         let f = ws.form_factors()?;
-        if f.n != n {
-            return Err(Error::input(
-                baked::form_factors::FILE,
-                format!(
-                    "shape {:?} does not match the {n} patches of {}; re-run form_factors",
-                    [f.n, f.n],
-                    baked::patches::FILE
-                ),
-            ));
-        }
+        check_shape(f.n, n)?;
         let t = transport(
             &f.values,
             n,
@@ -219,6 +316,135 @@ impl StageRun for TransportKnobs {
             },
             progress,
         )?;
+        self.finish(ws, txn, n, t)
+    }
+
+    fn shardable(&self) -> bool {
+        self.bounces == Bounces::Infinite
+    }
+
+    fn run_shard(
+        &self,
+        ws: &mut Workspace,
+        index: usize,
+        count: usize,
+        _progress: &dyn Progress,
+    ) -> Result<(String, Payload)> {
+        let budget = ws.memory_budget();
+        let albedo = albedos(ws.patches()?);
+        let n = albedo.len();
+        let f = ws.form_factors_mapped()?;
+        check_shape(f.n(), n)?;
+        let parts = infinite_part(f.values(), &albedo, Default::default(), budget, index, count)?;
+        let mut p = Payload::default();
+        for (c, part) in parts.into_iter().enumerate() {
+            p.f64s.insert(format!("error_{c}"), vec![part.error]);
+            p.u32s
+                .insert(format!("solver_{c}"), vec![part.solver as u32]);
+            let (cols, vals): (Vec<Vec<u32>>, Vec<Vec<f32>>) = part
+                .panels
+                .into_iter()
+                .map(|p| (p.columns, p.values))
+                .unzip();
+            p.u64s.insert(
+                format!("panel_widths_{c}"),
+                cols.iter().map(|c| c.len() as u64).collect(),
+            );
+            p.u32s.insert(format!("columns_{c}"), cols.concat());
+            p.f32s.insert(format!("values_{c}"), vals.concat());
+        }
+        let r = part_panels(n, index, count);
+        Ok((
+            format!("panels {}..{} of {} (n = {n})", r.start, r.end, panel_count(n)),
+            p,
+        ))
+    }
+
+    fn merge_shards(
+        &self,
+        ws: &mut Workspace,
+        txn: &mut BakeTransaction,
+        shards: Vec<(PathBuf, Payload)>,
+    ) -> Result<StageRecord> {
+        let albedo = albedos(ws.patches()?);
+        let n = albedo.len();
+        let f = ws.form_factors()?;
+        check_shape(f.n, n)?;
+        let channels = transport_channels(&albedo);
+        let mut parts = Vec::with_capacity(shards.len());
+        for (path, mut p) in shards {
+            let mut part = Vec::with_capacity(channels);
+            for c in 0..channels {
+                let solver = match p.u32s(&format!("solver_{c}"), &path)?.first() {
+                    Some(0) => InfiniteSolver::Auto,
+                    Some(1) => InfiniteSolver::F32,
+                    Some(2) => InfiniteSolver::F64,
+                    other => {
+                        return Err(Error::verify(&path, format!("unknown solver {other:?}")))
+                    }
+                };
+                let error = p.f64s(&format!("error_{c}"), &path)?[0];
+                let widths = p.u64s(&format!("panel_widths_{c}"), &path)?;
+                let cols = p.u32s(&format!("columns_{c}"), &path)?;
+                let vals = p.f32s(&format!("values_{c}"), &path)?;
+                let total: u64 = widths.iter().sum();
+                if cols.len() as u64 != total || vals.len() as u64 != total * n as u64 {
+                    return Err(Error::verify(&path, "its panels do not add up"));
+                }
+                if cols.iter().any(|&j| j as usize >= n) {
+                    return Err(Error::verify(&path, "a column index is out of range"));
+                }
+                let mut panels = Vec::with_capacity(widths.len());
+                let mut at = 0usize;
+                for w in widths {
+                    let w = w as usize;
+                    panels.push(Panel {
+                        columns: cols[at..at + w].to_vec(),
+                        values: vals[at * n..(at + w) * n].to_vec(),
+                    });
+                    at += w;
+                }
+                part.push(ChannelPart {
+                    solver,
+                    error,
+                    panels,
+                });
+            }
+            parts.push(part);
+        }
+        let t = assemble_infinite(&f.values, &albedo, parts)?;
+        self.finish(ws, txn, n, t)
+    }
+
+    fn estimate_shard(&self, state: &PlanState, index: usize, count: usize) -> u64 {
+        let n = state.patches as usize;
+        part_memory(n, state.channels.max(1) as usize, index, count)
+    }
+
+
+    fn estimate(&self, state: &mut PlanState) -> PlannedStage {
+        let n = state.patches as usize;
+        let channels = state.channels.max(1);
+        // The form factors are already counted as resident by the plan.
+        let bytes = memory_estimate(n, channels as usize, self.bounces) - (n * n) as u64 * 4;
+        PlannedStage {
+            stage: "transport".into(),
+            peak_bytes: bytes,
+            output_bytes: channels * state.patches * state.patches * 4,
+            notes: format!("{:?}, {channels} channel(s)", self.bounces),
+        }
+    }
+}
+
+impl TransportKnobs {
+    /// Write S and build the stage's record (shared by `run` and the merge of shards).
+    fn finish(
+        &self,
+        ws: &mut Workspace,
+        txn: &mut BakeTransaction,
+        n: usize,
+        t: Transport,
+    ) -> Result<StageRecord> {
         baked::transport::write(txn, &t.matrix)?;
         let mut rec = record("transport", &[baked::transport::FILE]);
         rec.report
@@ -250,17 +476,22 @@ impl StageRun for TransportKnobs {
         ws.set_transport(t.matrix);
         Ok(rec)
     }
+}
 
-    fn estimate(&self, state: &mut PlanState) -> PlannedStage {
-        let n = state.patches as usize;
-        let channels = state.channels.max(1);
-        // The form factors are already counted as resident by the plan.
-        let bytes = memory_estimate(n, channels as usize, self.bounces) - (n * n) as u64 * 4;
-        PlannedStage {
-            stage: "transport".into(),
-            peak_bytes: bytes,
-            output_bytes: channels * state.patches * state.patches * 4,
-            notes: format!("{:?}, {channels} channel(s)", self.bounces),
-        }
+fn albedos(set: &crate::radiosity::PatchSet) -> Vec<[f32; 3]> {
+    set.patches.iter().map(|p| p.albedo).collect()
+}
+
+fn check_shape(f_n: usize, n: usize) -> Result<()> {
+    if f_n != n {
+        return Err(Error::input(
+            baked::form_factors::FILE,
+            format!(
+                "shape {:?} does not match the {n} patches of {}; re-run form_factors",
+                [f_n, f_n],
+                baked::patches::FILE
+            ),
+        ));
     }
+    Ok(())
 }

@@ -1,0 +1,263 @@
+//! Shard files: one process's part of an expensive stage (`relume-bake run --shard I/N`), merged
+//! by `relume-bake merge` (docs/scale-out.md).
+//!
+//! A shard file `STAGE.I-of-N.shard` is
+//!
+//! ```text
+//! "RELUME-SHARD-01\n"          16 bytes
+//! header length                 u64 little-endian
+//! header                        JSON (ShardHeader)
+//! payload                       the sections, each little-endian, back to back
+//! ```
+//!
+//! The header names the bake (`bake`: the hash of the pipeline and the input file), the stage,
+//! the shard's index and count, the stage's cache key (relume's version and source, the baked
+//! format, the stage's knobs and the hashes of every file the stage reads: see `bake::cache`),
+//! and the payload's sections, size and SHA-256. It is written to `.NAME.tmp-PID` in the same
+//! directory and renamed into place, so a killed shard leaves either nothing or a whole file;
+//! the next shard written into that directory on the same host removes temporaries of processes
+//! that no longer run.
+
+use super::manifest::sha256_hex;
+use super::transaction::left_by_dead_process;
+use crate::error::{Error, IoContext, Result};
+use crate::pipeline::Pipeline;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+/// The first 16 bytes of every shard file.
+pub const MAGIC: &[u8; 16] = b"RELUME-SHARD-01\n";
+
+/// One array of the payload.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Section {
+    pub name: String,
+    /// `f32`, `f64`, `u32` or `u64`.
+    pub dtype: String,
+    /// Elements.
+    pub len: u64,
+}
+
+/// What a shard file says about itself.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShardHeader {
+    /// SHA-256 of the pipeline (JSON) and the input file's hash: which bake this is part of.
+    pub bake: String,
+    /// The stage this is part of (`form_factors`, `transport`).
+    pub stage: String,
+    pub index: u32,
+    pub count: u32,
+    /// The stage's cache key: equal keys mean equal inputs, knobs and relume.
+    pub key: String,
+    pub relume_version: String,
+    /// The pipeline, so that `merge` can finish the bake.
+    pub pipeline: Pipeline,
+    /// What part of the stage this is, for people (`rows 0..150 of 600`).
+    pub part: String,
+    /// Numbers the merge needs besides the arrays (e.g. the solver a transport shard used).
+    pub facts: BTreeMap<String, String>,
+    pub sections: Vec<Section>,
+    pub payload_bytes: u64,
+    pub payload_sha256: String,
+}
+
+/// The arrays of a shard, by section name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Payload {
+    pub f32s: BTreeMap<String, Vec<f32>>,
+    pub f64s: BTreeMap<String, Vec<f64>>,
+    pub u32s: BTreeMap<String, Vec<u32>>,
+    pub u64s: BTreeMap<String, Vec<u64>>,
+}
+
+impl Payload {
+    fn take<T>(map: &mut BTreeMap<String, Vec<T>>, name: &str, path: &Path) -> Result<Vec<T>> {
+        map.remove(name)
+            .ok_or_else(|| Error::verify(path, format!("the shard has no section `{name}`")))
+    }
+    pub fn f32s(&mut self, name: &str, path: &Path) -> Result<Vec<f32>> {
+        Self::take(&mut self.f32s, name, path)
+    }
+    pub fn f64s(&mut self, name: &str, path: &Path) -> Result<Vec<f64>> {
+        Self::take(&mut self.f64s, name, path)
+    }
+    pub fn u32s(&mut self, name: &str, path: &Path) -> Result<Vec<u32>> {
+        Self::take(&mut self.u32s, name, path)
+    }
+    pub fn u64s(&mut self, name: &str, path: &Path) -> Result<Vec<u64>> {
+        Self::take(&mut self.u64s, name, path)
+    }
+
+    fn sections_and_bytes(&self) -> (Vec<Section>, Vec<u8>) {
+        let mut sections = Vec::new();
+        let mut bytes = Vec::new();
+        let mut put = |name: &str, dtype: &str, len: usize, data: Vec<u8>| {
+            sections.push(Section {
+                name: name.into(),
+                dtype: dtype.into(),
+                len: len as u64,
+            });
+            bytes.extend(data);
+        };
+        for (k, v) in &self.f32s {
+            put(k, "f32", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+        }
+        for (k, v) in &self.f64s {
+            put(k, "f64", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+        }
+        for (k, v) in &self.u32s {
+            put(k, "u32", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+        }
+        for (k, v) in &self.u64s {
+            put(k, "u64", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+        }
+        (sections, bytes)
+    }
+}
+
+/// The file name of shard `index` of `count` of `stage`.
+pub fn file_name(stage: &str, index: u32, count: u32) -> String {
+    format!("{stage}.{index}-of-{count}.shard")
+}
+
+/// Write a shard into `dir` atomically; returns its path. `header`'s sections, size and hash are
+/// filled in here.
+pub fn write(dir: &Path, mut header: ShardHeader, payload: &Payload) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).at(dir, "cannot create the shard directory")?;
+    clean_stale(dir);
+    let (sections, bytes) = payload.sections_and_bytes();
+    header.sections = sections;
+    header.payload_bytes = bytes.len() as u64;
+    header.payload_sha256 = sha256_hex(&bytes);
+    let json = serde_json::to_vec(&header).map_err(|e| Error::Internal(e.to_string()))?;
+    let name = file_name(&header.stage, header.index, header.count);
+    let path = dir.join(&name);
+    let tmp = dir.join(format!(".{name}.tmp-{}-{}", host(), std::process::id()));
+    let result = (|| -> std::io::Result<()> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        f.write_all(MAGIC)?;
+        f.write_all(&(json.len() as u64).to_le_bytes())?;
+        f.write_all(&json)?;
+        f.write_all(&bytes)?;
+        f.into_inner().map_err(|e| e.into_error())?.sync_all()
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::io(&tmp, "cannot write the shard", e));
+    }
+    std::fs::rename(&tmp, &path).at(&path, "cannot move the shard into place")?;
+    Ok(path)
+}
+
+/// This machine's host name (temporaries of other hosts sharing the directory are left alone:
+/// whether their process runs cannot be told from here).
+fn host() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|h| h.trim().replace(['/', '-'], "_"))
+        .unwrap_or_else(|_| "host".into())
+}
+
+/// Remove `.NAME.shard.tmp-HOST-PID` files of this host's processes that no longer run.
+fn clean_stale(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mine = format!(".shard.tmp-{}-", host());
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some((_, pid)) = name.rsplit_once(&mine) else {
+            continue;
+        };
+        if let Ok(pid) = pid.parse::<u32>() {
+            if name.starts_with('.') && left_by_dead_process(&e.path(), pid) {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
+/// Read a shard's header, checking the magic and that the file is as long as it says.
+pub fn read_header(path: &Path) -> Result<ShardHeader> {
+    let mut f = std::fs::File::open(path).at(path, "cannot read the shard")?;
+    let mut magic = [0u8; 16];
+    let mut len = [0u8; 8];
+    f.read_exact(&mut magic)
+        .and_then(|_| f.read_exact(&mut len))
+        .map_err(|_| Error::verify(path, "not a relume shard (too short)"))?;
+    if &magic != MAGIC {
+        return Err(Error::verify(path, "not a relume shard (bad magic)"));
+    }
+    let len = u64::from_le_bytes(len);
+    let size = f.metadata().at(path, "cannot read the shard")?.len();
+    if len > size {
+        return Err(Error::verify(path, "truncated: the header ends past the file"));
+    }
+    let mut json = vec![0u8; len as usize];
+    f.read_exact(&mut json)
+        .map_err(|_| Error::verify(path, "truncated: the header ends past the file"))?;
+    let header: ShardHeader = serde_json::from_slice(&json)
+        .map_err(|e| Error::verify(path, format!("the shard's header is malformed: {e}")))?;
+    let want = 24 + len + header.payload_bytes;
+    if size != want {
+        return Err(Error::verify(
+            path,
+            format!(
+                "truncated or padded: {size} bytes, the header says {want} (was the shard still being copied?)"
+            ),
+        ));
+    }
+    Ok(header)
+}
+
+/// Read a shard whole: header and payload, the payload's SHA-256 checked.
+pub fn read(path: &Path) -> Result<(ShardHeader, Payload)> {
+    let header = read_header(path)?;
+    let bytes = std::fs::read(path).at(path, "cannot read the shard")?;
+    let start = bytes.len() - header.payload_bytes as usize;
+    let data = &bytes[start..];
+    if sha256_hex(data) != header.payload_sha256 {
+        return Err(Error::verify(
+            path,
+            "damaged: the payload does not match its SHA-256",
+        ));
+    }
+    let mut payload = Payload::default();
+    let mut at = 0usize;
+    for s in &header.sections {
+        let width = match s.dtype.as_str() {
+            "f32" | "u32" => 4,
+            "f64" | "u64" => 8,
+            other => return Err(Error::verify(path, format!("unknown section type `{other}`"))),
+        };
+        let end = at + s.len as usize * width;
+        let raw = data
+            .get(at..end)
+            .ok_or_else(|| Error::verify(path, "the sections run past the payload"))?;
+        let name = s.name.clone();
+        match s.dtype.as_str() {
+            "f32" => {
+                let v = raw.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap()));
+                payload.f32s.insert(name, v.collect());
+            }
+            "u32" => {
+                let v = raw.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap()));
+                payload.u32s.insert(name, v.collect());
+            }
+            "f64" => {
+                let v = raw.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap()));
+                payload.f64s.insert(name, v.collect());
+            }
+            _ => {
+                let v = raw.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap()));
+                payload.u64s.insert(name, v.collect());
+            }
+        }
+        at = end;
+    }
+    if at != data.len() {
+        return Err(Error::verify(path, "the payload is longer than its sections"));
+    }
+    Ok((header, payload))
+}
