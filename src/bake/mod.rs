@@ -11,16 +11,16 @@ pub mod workspace;
 pub use estimate::{Measured, PlanState, PlannedStage};
 pub use plan::{plan, Plan};
 
+use crate::baked::shard::ShardHeader;
 use crate::baked::{self, manifest::hash_file, BakeTransaction, FileRecord, Manifest, StageRecord};
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::load::{load_input, LoadedInput};
 use crate::pipeline::{Pipeline, Stage};
 use crate::progress::Progress;
-use crate::baked::shard::ShardHeader;
 use cache::StageCache;
-pub use shard::{ShardWritten, Sharding};
 use serde::Serialize;
+pub use shard::{ShardWritten, Sharding};
 use stages::runner;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -158,17 +158,25 @@ pub fn run_pipeline(
                     Sharding::Shard { index, count, .. } => Some((*index, *count)),
                     _ => None,
                 };
-                if sharding.is_some() && !pipeline.stages[i..].iter().any(|s| runner(s).shardable()) {
+                if sharding.is_some() && !pipeline.stages[i..].iter().any(|s| runner(s).shardable())
+                {
                     // Every shardable stage is in the cache: the rest is the merge's.
-                    return Ok(partial_report(output, timings, warnings, estimated_peak, None, None));
+                    return Ok(partial_report(
+                        output,
+                        timings,
+                        warnings,
+                        estimated_peak,
+                        None,
+                        None,
+                    ));
                 }
                 let rest = plan::plan_measured(pipeline, &plan_input, output, &measured);
                 // The first stage that runs answers for the load too; a shard answers for its
                 // own part only.
                 let peak = match sharding {
-                    Some((index, count)) if runner(stage).shardable() => plan::shard_peak(
-                        pipeline, &plan_input, &measured, i, index, count,
-                    ),
+                    Some((index, count)) if runner(stage).shardable() => {
+                        plan::shard_peak(pipeline, &plan_input, &measured, i, index, count)
+                    }
                     _ => rest.peak_from(if ran_any { i + 1 } else { 0 }),
                 };
                 ran_any = true;
@@ -207,18 +215,32 @@ pub fn run_pipeline(
                         tm.outputs = vec![path.display().to_string()];
                         tm.peak_rss_bytes = limits::peak_rss();
                         timings.push(tm);
-                        return Ok(partial_report(output, timings, warnings, estimated_peak, Some(ShardWritten {
-                            stage: name.into(),
-                            index: *index,
-                            count: *count,
-                            part,
-                            path,
-                        }), None));
+                        return Ok(partial_report(
+                            output,
+                            timings,
+                            warnings,
+                            estimated_peak,
+                            Some(ShardWritten {
+                                stage: name.into(),
+                                index: *index,
+                                count: *count,
+                                part,
+                                path,
+                            }),
+                            None,
+                        ));
                     }
                     (Sharding::Merge { .. }, true) => {
                         let set = merge_set.as_ref().expect("scanned for a merge");
                         let Some(paths) = set.complete(name, &key)? else {
-                            return Ok(partial_report(output, timings, warnings, estimated_peak, None, Some(name.into())));
+                            return Ok(partial_report(
+                                output,
+                                timings,
+                                warnings,
+                                estimated_peak,
+                                None,
+                                Some(name.into()),
+                            ));
                         };
                         let mut shards = Vec::with_capacity(paths.len());
                         for p in paths {
@@ -252,7 +274,14 @@ pub fn run_pipeline(
 
     if matches!(opts.sharding, Sharding::Shard { .. }) {
         // Every stage was in the cache: nothing to shard, the output is the merge's to write.
-        return Ok(partial_report(output, timings, warnings, estimated_peak, None, None));
+        return Ok(partial_report(
+            output,
+            timings,
+            warnings,
+            estimated_peak,
+            None,
+            None,
+        ));
     }
     let (bytes, sha256) = hash_file(pipeline.input.path())?;
     let input_name = pipeline

@@ -204,6 +204,33 @@ pub struct ShardPlan {
     pub merge_peak_bytes: u64,
 }
 
+impl ShardPlan {
+    /// The split plan as text for people (`plan --shards N`).
+    pub fn to_text(&self) -> String {
+        use crate::limits::human_bytes;
+        if self.rounds.is_empty() {
+            return "shards: no stage of this pipeline is split (form_factors, or transport with bounces: Infinite)\n".into();
+        }
+        let mut t = String::from("\nsplit     stage            shard peak  shard file\n");
+        for (r, s) in self.rounds.iter().enumerate() {
+            t += &format!(
+                "round {}   {:<16} {:>10}  {:>10}  x {}\n",
+                r + 1,
+                s.stage,
+                human_bytes(s.shard_peak_bytes),
+                human_bytes(s.shard_bytes),
+                s.count
+            );
+        }
+        t += &format!(
+            "merge peak {} ({} round(s): `run --shard I/N` for every I, then `merge`, per round)\n",
+            human_bytes(self.merge_peak_bytes),
+            self.rounds.len()
+        );
+        t
+    }
+}
+
 /// One shardable stage split `count` ways.
 #[derive(Clone, Debug, Serialize)]
 pub struct ShardRound {

@@ -59,9 +59,8 @@ impl ShardSet {
     pub fn scan(dirs: &[PathBuf]) -> Result<Self> {
         let mut headers = Vec::new();
         for d in dirs {
-            let entries = std::fs::read_dir(d).map_err(|e| {
-                Error::io(d, "cannot list the shard directory", e)
-            })?;
+            let entries = std::fs::read_dir(d)
+                .map_err(|e| Error::io(d, "cannot list the shard directory", e))?;
             let mut paths: Vec<PathBuf> = entries
                 .flatten()
                 .map(|e| e.path())
@@ -124,8 +123,11 @@ impl ShardSet {
     /// The complete, consistent set of shards of `stage` with cache key `key`, in index order;
     /// `None` when there is no shard of `stage` at all.
     pub fn complete(&self, stage: &str, key: &str) -> Result<Option<Vec<PathBuf>>> {
-        let of: Vec<&(PathBuf, ShardHeader)> =
-            self.headers.iter().filter(|(_, h)| h.stage == stage).collect();
+        let of: Vec<&(PathBuf, ShardHeader)> = self
+            .headers
+            .iter()
+            .filter(|(_, h)| h.stage == stage)
+            .collect();
         let Some((first_path, first)) = of.first().map(|(p, h)| (p, h)) else {
             return Ok(None);
         };
@@ -159,7 +161,10 @@ impl ShardSet {
         for (p, h) in &of {
             let i = h.index as usize;
             if i >= count {
-                return Err(Error::verify(p, format!("index {i} is not below its count {count}")));
+                return Err(Error::verify(
+                    p,
+                    format!("index {i} is not below its count {count}"),
+                ));
             }
             if let Some(other) = slots[i] {
                 return Err(Error::verify(
@@ -188,7 +193,9 @@ impl ShardSet {
                 ),
             ));
         }
-        Ok(Some(slots.into_iter().map(|s| s.unwrap().clone()).collect()))
+        Ok(Some(
+            slots.into_iter().map(|s| s.unwrap().clone()).collect(),
+        ))
     }
 }
 
@@ -198,11 +205,18 @@ pub fn parse_shard(text: &str) -> std::result::Result<(usize, usize), String> {
         .split_once('/')
         .ok_or_else(|| format!("`{text}`: expected I/N, e.g. 0/4"))?;
     let (i, n): (usize, usize) = (
-        i.trim().parse().map_err(|_| format!("`{i}` is not a shard index"))?,
-        n.trim().parse().map_err(|_| format!("`{n}` is not a shard count"))?,
+        i.trim()
+            .parse()
+            .map_err(|_| format!("`{i}` is not a shard index"))?,
+        n.trim()
+            .parse()
+            .map_err(|_| format!("`{n}` is not a shard count"))?,
     );
     if n == 0 || i >= n {
-        return Err(format!("shard {i}/{n}: the index must be below the count (0/{n} .. {}/{n})", n.max(1) - 1));
+        return Err(format!(
+            "shard {i}/{n}: the index must be below the count (0/{n} .. {}/{n})",
+            n.max(1) - 1
+        ));
     }
     Ok((i, n))
 }
@@ -238,7 +252,11 @@ pub fn shard_from_env(
         (Some(n), _) => n,
         (None, Some(n)) if source == "SLURM_ARRAY_TASK_ID" => n,
         _ if source == "SLURM_ARRAY_TASK_ID" => return Ok(None), // a plain Slurm job step
-        _ => return Err("JOB_COMPLETION_INDEX is set: give the number of shards with --shards N".into()),
+        _ => {
+            return Err(
+                "JOB_COMPLETION_INDEX is set: give the number of shards with --shards N".into(),
+            )
+        }
     };
     if count == 0 || index >= count {
         return Err(format!("{source}={index} is not below the shard count {count} (Slurm arrays here start at 0: --array=0-{})", count.max(1) - 1));
@@ -257,16 +275,32 @@ mod tests {
         assert!(parse_shard("1/0").is_err());
         assert!(parse_shard("x").is_err());
         let env = |vars: &'static [(&'static str, &'static str)]| {
-            move |k: &str| vars.iter().find(|(n, _)| *n == k).map(|(_, v)| v.to_string())
+            move |k: &str| {
+                vars.iter()
+                    .find(|(n, _)| *n == k)
+                    .map(|(_, v)| v.to_string())
+            }
         };
-        let slurm = [("SLURM_ARRAY_TASK_ID", "3"), ("SLURM_ARRAY_TASK_COUNT", "4")];
-        assert_eq!(shard_from_env(None, env(&slurm)), Ok(Some((3, 4, "SLURM_ARRAY_TASK_ID"))));
+        let slurm = [
+            ("SLURM_ARRAY_TASK_ID", "3"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ];
+        assert_eq!(
+            shard_from_env(None, env(&slurm)),
+            Ok(Some((3, 4, "SLURM_ARRAY_TASK_ID")))
+        );
         assert_eq!(shard_from_env(None, env(&[])), Ok(None));
         let k8s = [("JOB_COMPLETION_INDEX", "1")];
-        assert_eq!(shard_from_env(Some(2), env(&k8s)), Ok(Some((1, 2, "JOB_COMPLETION_INDEX"))));
+        assert_eq!(
+            shard_from_env(Some(2), env(&k8s)),
+            Ok(Some((1, 2, "JOB_COMPLETION_INDEX")))
+        );
         assert!(shard_from_env(None, env(&k8s)).is_err());
         assert!(shard_from_env(Some(4), env(&[])).is_err());
-        let over = [("SLURM_ARRAY_TASK_ID", "4"), ("SLURM_ARRAY_TASK_COUNT", "4")];
+        let over = [
+            ("SLURM_ARRAY_TASK_ID", "4"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ];
         assert!(shard_from_env(None, env(&over)).is_err());
     }
 }

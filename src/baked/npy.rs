@@ -95,7 +95,10 @@ pub fn parse_npy_f32(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<f32>), 
 /// Parse the bytes of a `.npy` file of `T` (see [`read_npy_f32`]); the error is a message.
 pub fn parse_npy<T: NpyElement>(bytes: &[u8]) -> std::result::Result<(Vec<u64>, Vec<T>), String> {
     let (shape, offset) = parse_npy_header::<T>(bytes)?;
-    let values = bytes[offset..].chunks_exact(T::SIZE).map(T::from_le).collect();
+    let values = bytes[offset..]
+        .chunks_exact(T::SIZE)
+        .map(T::from_le)
+        .collect();
     Ok((shape, values))
 }
 

@@ -102,16 +102,36 @@ impl Payload {
             bytes.extend(data);
         };
         for (k, v) in &self.f32s {
-            put(k, "f32", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+            put(
+                k,
+                "f32",
+                v.len(),
+                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            );
         }
         for (k, v) in &self.f64s {
-            put(k, "f64", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+            put(
+                k,
+                "f64",
+                v.len(),
+                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            );
         }
         for (k, v) in &self.u32s {
-            put(k, "u32", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+            put(
+                k,
+                "u32",
+                v.len(),
+                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            );
         }
         for (k, v) in &self.u64s {
-            put(k, "u64", v.len(), v.iter().flat_map(|x| x.to_le_bytes()).collect());
+            put(
+                k,
+                "u64",
+                v.len(),
+                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            );
         }
         (sections, bytes)
     }
@@ -192,7 +212,10 @@ pub fn read_header(path: &Path) -> Result<ShardHeader> {
     let len = u64::from_le_bytes(len);
     let size = f.metadata().at(path, "cannot read the shard")?.len();
     if len > size {
-        return Err(Error::verify(path, "truncated: the header ends past the file"));
+        return Err(Error::verify(
+            path,
+            "truncated: the header ends past the file",
+        ));
     }
     let mut json = vec![0u8; len as usize];
     f.read_exact(&mut json)
@@ -229,7 +252,12 @@ pub fn read(path: &Path) -> Result<(ShardHeader, Payload)> {
         let width = match s.dtype.as_str() {
             "f32" | "u32" => 4,
             "f64" | "u64" => 8,
-            other => return Err(Error::verify(path, format!("unknown section type `{other}`"))),
+            other => {
+                return Err(Error::verify(
+                    path,
+                    format!("unknown section type `{other}`"),
+                ))
+            }
         };
         let end = at + s.len as usize * width;
         let raw = data
@@ -238,26 +266,37 @@ pub fn read(path: &Path) -> Result<(ShardHeader, Payload)> {
         let name = s.name.clone();
         match s.dtype.as_str() {
             "f32" => {
-                let v = raw.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap()));
+                let v = raw
+                    .chunks_exact(4)
+                    .map(|c| f32::from_le_bytes(c.try_into().unwrap()));
                 payload.f32s.insert(name, v.collect());
             }
             "u32" => {
-                let v = raw.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap()));
+                let v = raw
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes(c.try_into().unwrap()));
                 payload.u32s.insert(name, v.collect());
             }
             "f64" => {
-                let v = raw.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap()));
+                let v = raw
+                    .chunks_exact(8)
+                    .map(|c| f64::from_le_bytes(c.try_into().unwrap()));
                 payload.f64s.insert(name, v.collect());
             }
             _ => {
-                let v = raw.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap()));
+                let v = raw
+                    .chunks_exact(8)
+                    .map(|c| u64::from_le_bytes(c.try_into().unwrap()));
                 payload.u64s.insert(name, v.collect());
             }
         }
         at = end;
     }
     if at != data.len() {
-        return Err(Error::verify(path, "the payload is longer than its sections"));
+        return Err(Error::verify(
+            path,
+            "the payload is longer than its sections",
+        ));
     }
     Ok((header, payload))
 }

@@ -110,9 +110,9 @@ pub fn assemble_infinite(
             .push(infinite_bounds(RowMajor { f, rho: &rho })?);
         let mut solver = None;
         for (i, part) in parts.iter().enumerate() {
-            let ch = part.get(c).ok_or_else(|| {
-                Error::Internal(format!("transport part {i} has no channel {c}"))
-            })?;
+            let ch = part
+                .get(c)
+                .ok_or_else(|| Error::Internal(format!("transport part {i} has no channel {c}")))?;
             let want = part_panels(n, i, count).len();
             if ch.panels.len() != want {
                 return Err(Error::Internal(format!(
@@ -132,7 +132,8 @@ pub fn assemble_infinite(
             }
             scatter(&ch.panels, n, &mut values[c * n * n..(c + 1) * n * n]);
         }
-        out.solvers.push(solver.unwrap_or((InfiniteSolver::F32, 0.0)));
+        out.solvers
+            .push(solver.unwrap_or((InfiniteSolver::F32, 0.0)));
     }
     out.matrix = TransportMatrix::new(channels, n, values)?;
     Ok(out)

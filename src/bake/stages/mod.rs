@@ -10,10 +10,10 @@ use super::estimate::{PlanState, PlannedStage};
 use super::workspace::Workspace;
 use crate::baked::shard::Payload;
 use crate::baked::{BakeTransaction, StageRecord};
-use std::path::PathBuf;
 use crate::error::Result;
 use crate::pipeline::Stage;
 use crate::progress::Progress;
+use std::path::PathBuf;
 
 /// What every stage's knob struct implements: run over a [`Workspace`], and estimate its cost.
 pub trait StageRun {
@@ -42,7 +42,9 @@ pub trait StageRun {
         _count: usize,
         _progress: &dyn Progress,
     ) -> Result<(String, Payload)> {
-        Err(crate::error::Error::Internal("this stage has no shards".into()))
+        Err(crate::error::Error::Internal(
+            "this stage has no shards".into(),
+        ))
     }
 
     /// Put every shard's arrays (in index order) together, write the stage's files into `txn`
@@ -53,7 +55,9 @@ pub trait StageRun {
         _txn: &mut BakeTransaction,
         _shards: Vec<(PathBuf, Payload)>,
     ) -> Result<StageRecord> {
-        Err(crate::error::Error::Internal("this stage has no shards".into()))
+        Err(crate::error::Error::Internal(
+            "this stage has no shards".into(),
+        ))
     }
 
     /// Estimated peak bytes of shard `index` of `count` (after `estimate` updated `state`).

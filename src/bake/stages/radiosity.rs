@@ -3,23 +3,25 @@
 use super::{record, StageRun};
 use crate::bake::estimate::{PlanState, PlannedStage};
 use crate::bake::workspace::Workspace;
+use crate::baked::shard::Payload;
 use crate::baked::{self, form_factors::FormFactorMatrix, BakeTransaction, StageRecord};
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
 use crate::progress::Progress;
-use crate::baked::shard::Payload;
 use crate::radiosity::formfactor::{
     assemble, form_factor_rows, form_factors, shard_rows, Estimator, FormFactors, RowBlock,
 };
-use std::path::PathBuf;
 use crate::radiosity::infinite::InfiniteSolver;
 use crate::radiosity::lu_panels::{panel_count, Panel};
-use crate::radiosity::transport::{memory_estimate, transport, Bounces, Transport, TransportParams};
+use crate::radiosity::transport::{
+    memory_estimate, transport, Bounces, Transport, TransportParams,
+};
 use crate::radiosity::transport_shard::{
     assemble_infinite, channels as transport_channels, infinite_part, part_memory, part_panels,
     ChannelPart,
 };
 use crate::radiosity::voxelize::{voxelize_noting, Resolution};
+use std::path::PathBuf;
 
 impl StageRun for VoxelizeKnobs {
     fn run(
@@ -202,7 +204,12 @@ impl StageRun for FormFactorsKnobs {
         let n = state.patches as usize;
         let rows = shard_rows(self.estimator, n, index, count).len() as u64;
         // Hemisphere rows in f32; pairwise upper rows in f64, at most n entries each.
-        let per_row = state.patches * if self.estimator == Estimator::Pairwise { 8 } else { 4 };
+        let per_row = state.patches
+            * if self.estimator == Estimator::Pairwise {
+                8
+            } else {
+                4
+            };
         state.triangles * 256 + rows * per_row
     }
 
@@ -335,7 +342,14 @@ impl StageRun for TransportKnobs {
         let n = albedo.len();
         let f = ws.form_factors_mapped()?;
         check_shape(f.n(), n)?;
-        let parts = infinite_part(f.values(), &albedo, Default::default(), budget, index, count)?;
+        let parts = infinite_part(
+            f.values(),
+            &albedo,
+            Default::default(),
+            budget,
+            index,
+            count,
+        )?;
         let mut p = Payload::default();
         for (c, part) in parts.into_iter().enumerate() {
             p.f64s.insert(format!("error_{c}"), vec![part.error]);
@@ -355,7 +369,12 @@ impl StageRun for TransportKnobs {
         }
         let r = part_panels(n, index, count);
         Ok((
-            format!("panels {}..{} of {} (n = {n})", r.start, r.end, panel_count(n)),
+            format!(
+                "panels {}..{} of {} (n = {n})",
+                r.start,
+                r.end,
+                panel_count(n)
+            ),
             p,
         ))
     }
@@ -379,9 +398,7 @@ impl StageRun for TransportKnobs {
                     Some(0) => InfiniteSolver::Auto,
                     Some(1) => InfiniteSolver::F32,
                     Some(2) => InfiniteSolver::F64,
-                    other => {
-                        return Err(Error::verify(&path, format!("unknown solver {other:?}")))
-                    }
+                    other => return Err(Error::verify(&path, format!("unknown solver {other:?}"))),
                 };
                 let error = p.f64s(&format!("error_{c}"), &path)?[0];
                 let widths = p.u64s(&format!("panel_widths_{c}"), &path)?;
@@ -420,7 +437,6 @@ impl StageRun for TransportKnobs {
         let n = state.patches as usize;
         part_memory(n, state.channels.max(1) as usize, index, count)
     }
-
 
     fn estimate(&self, state: &mut PlanState) -> PlannedStage {
         let n = state.patches as usize;

@@ -5,6 +5,7 @@ mod compress;
 mod freeform;
 mod horizon;
 mod radiosity;
+mod scale;
 mod study;
 mod sun_args;
 mod terrain;
@@ -74,7 +75,13 @@ enum Command {
         /// Run every stage, even when the output is up to date or the cache holds them
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        shard: scale::ShardArgs,
     },
+    /// Assemble the shards of a bake (`run --shard I/N`) into its baked directory, byte for byte
+    /// what a single `run` writes
+    #[command(after_help = EXIT_CODES)]
+    Merge(scale::MergeArgs),
     /// Show the stages a pipeline would run, with estimated peak memory and output size; writes nothing
     Plan {
         /// Pipeline file (RON)
@@ -82,6 +89,9 @@ enum Command {
         /// Output directory to report (default as for `run`)
         #[arg(short, long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Also plan the bake split into N shards: per-shard and merge peak memory, shard sizes
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65536))]
+        shards: Option<u32>,
     },
     /// Show a baked directory's manifest and verify every file's size and hash
     #[command(after_help = EXIT_CODES)]
@@ -244,6 +254,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             cache,
             no_cache,
             force,
+            shard,
         } => {
             let p = relume::pipeline::parse_pipeline(pipeline)?;
             let out = relume::pipeline::output_dir(pipeline, &p, out.as_deref());
@@ -255,24 +266,71 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             if !no_cache {
                 opts.cache = Some(cache.clone().unwrap_or_else(|| default_cache(&out)));
             }
+            let (sharding, note) = shard.sharding(&out)?;
+            let sharded = !matches!(sharding, relume::bake::Sharding::Whole);
+            opts.sharding = sharding;
+            if let Some(note) = note {
+                ui.note(&note);
+            }
             let report = relume::bake::run_pipeline(&p, &out, &opts, ui)?;
             if json {
                 print_json(&report);
             } else if !cli.global.quiet {
-                eprint!("{}", bake_summary(&report));
+                match scale::summary(&report, &out) {
+                    Some(s) => eprint!("{s}"),
+                    None if sharded => eprint!("{}", scale::nothing_to_shard(&out)),
+                    None => eprint!("{}", bake_summary(&report)),
+                }
             }
             Ok(exit::OK)
         }
-        Command::Plan { pipeline, out } => {
+        Command::Merge(m) => {
+            let set = relume::bake::shard::ShardSet::scan(&m.shard_dirs)?;
+            let p = set.pipeline().clone();
+            let mut opts = relume::bake::BakeOptions::default();
+            if let Some(mm) = m.max_memory {
+                opts.max_memory = mm;
+            }
+            opts.cache = Some(m.cache.clone().unwrap_or_else(|| default_cache(&m.output)));
+            opts.sharding = relume::bake::Sharding::Merge {
+                dirs: m.shard_dirs.clone(),
+            };
+            let report = relume::bake::run_pipeline(&p, &m.output, &opts, ui)?;
+            if json {
+                print_json(&report);
+            } else if !cli.global.quiet {
+                match scale::summary(&report, &m.output) {
+                    Some(s) => eprint!("{s}"),
+                    None => eprint!("{}", bake_summary(&report)),
+                }
+            }
+            Ok(exit::OK)
+        }
+        Command::Plan {
+            pipeline,
+            out,
+            shards,
+        } => {
             let p = relume::pipeline::parse_pipeline(pipeline)?;
             let out = relume::pipeline::output_dir(pipeline, &p, out.as_deref());
             relume::limits::baseline_rss();
             let input = relume::load::load_input(&p.input)?;
             let plan = relume::bake::plan(&p, &input, &out);
+            let split = shards.map(|n| {
+                relume::bake::plan::plan_shards(
+                    &p,
+                    &relume::bake::plan::PlanInput::of(&input),
+                    &Default::default(),
+                    n as usize,
+                )
+            });
             if json {
-                print_json(&plan);
+                print_json(&serde_json::json!({"plan": plan, "shards": split}));
             } else {
                 print!("{}", plan.to_text(pipeline));
+                if let Some(s) = &split {
+                    print!("{}", s.to_text());
+                }
             }
             Ok(exit::OK)
         }

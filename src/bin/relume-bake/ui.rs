@@ -76,6 +76,15 @@ impl Progress for Ui {
     }
 }
 
+impl Ui {
+    /// A line for people (not a warning), unless quiet.
+    pub fn note(&self, message: &str) {
+        if !self.quiet {
+            eprintln!("note: {message}");
+        }
+    }
+}
+
 /// Print an error and its cause chain the way people expect from a CLI.
 pub fn print_error(e: &relume::Error) {
     eprintln!("error: {e}");

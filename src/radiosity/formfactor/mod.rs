@@ -208,7 +208,11 @@ pub fn assemble(
             set.len()
         )));
     }
-    let areas: Vec<f64> = set.patches.iter().map(|p| piece_sampler(set, p).area).collect();
+    let areas: Vec<f64> = set
+        .patches
+        .iter()
+        .map(|p| piece_sampler(set, p).area)
+        .collect();
     Ok(assemble_with(&areas, params, blocks))
 }
 
