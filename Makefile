@@ -5,13 +5,13 @@ CARGO    ?= cargo
 BAKE     := target/release/relume-bake
 PLAYER   := target/release/relume-player
 SUDO     := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth gdal-bin
+APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth gdal-bin slurm-wlm munge
 PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder rasterio embreex mitsuba
 export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
 
-.PHONY: all build demo docs-images test deps deps-apt deps-py deps-npm fuzz fmt lint bench bench-grass study ci clean
+.PHONY: all build demo docs-images test test-slurm deps deps-apt deps-py deps-npm fuzz fmt lint bench bench-grass study ci clean
 
 all: build
 
@@ -122,6 +122,13 @@ docs-images: build
 test: deps
 	@mkdir -p -m 0700 $(XDG_RUNTIME_DIR)
 	$(CARGO) test --release --locked
+	$(MAKE) --no-print-directory test-slurm
+
+## A real single-node Slurm cluster on this machine (munged, slurmctld, slurmd): a sharded bake
+## as job arrays and merges, then again with one task killed and requeued; both merged bakes
+## byte-identical to a single-process run (about 40 s; needs root or sudo for the daemons).
+test-slurm: build
+	scripts/slurm/test-slurm.sh
 
 ## GRASS r.sunmask side by side (optional: skips without grass-core; about 4 minutes)
 bench-grass:

@@ -436,3 +436,35 @@ fn row_blocks_and_transport_parts_assemble_exactly_for_any_split() {
         assert!(got == whole, "transport in {count} parts");
     }
 }
+
+/// faer partitions its work by the parallelism it is given: the transport fixes it, so that a
+/// bake is the same for any pool size at real sizes too. With the pool's size it was not:
+/// door-ajar.ron (2,000 patches, two rooms) gave a different transport.npy with -j 1 and -j 2,
+/// and so did every shard run with fewer threads than the single process.
+#[test]
+fn door_ajar_bakes_are_identical_for_any_thread_count() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = data("pipelines/door-ajar.ron");
+    let mut bakes = Vec::new();
+    for j in ["1", "2", "3"] {
+        let out = tmp.path().join(format!("door-{j}"));
+        expect_code(
+            &bake(
+                tmp.path(),
+                &["-q", "-j", j, "run", s(&p), "--out", s(&out), "--no-cache"],
+            ),
+            0,
+        );
+        bakes.push(contents(&out));
+    }
+    for (k, b) in bakes.iter().enumerate().skip(1) {
+        for (x, y) in bakes[0].iter().zip(b) {
+            assert!(
+                x.0 == y.0 && x.1 == y.1,
+                "{} differs between -j 1 and -j {}",
+                x.0,
+                k + 1
+            );
+        }
+    }
+}

@@ -11,7 +11,6 @@ pub mod workspace;
 pub use estimate::{Measured, PlanState, PlannedStage};
 pub use plan::{plan, Plan};
 
-use crate::baked::shard::ShardHeader;
 use crate::baked::{self, manifest::hash_file, BakeTransaction, FileRecord, Manifest, StageRecord};
 use crate::error::{Error, Result};
 use crate::limits;
@@ -161,14 +160,7 @@ pub fn run_pipeline(
                 if sharding.is_some() && !pipeline.stages[i..].iter().any(|s| runner(s).shardable())
                 {
                     // Every shardable stage is in the cache: the rest is the merge's.
-                    return Ok(partial_report(
-                        output,
-                        timings,
-                        warnings,
-                        estimated_peak,
-                        None,
-                        None,
-                    ));
+                    return Ok(partial_report(output, timings, warnings, estimated_peak));
                 }
                 let rest = plan::plan_measured(pipeline, &plan_input, output, &measured);
                 // The first stage that runs answers for the load too; a shard answers for its
@@ -194,59 +186,35 @@ pub fn run_pipeline(
                                 "--shard needs the stage cache (drop --no-cache): the merge and the next round of shards find the stages all shards share there",
                             ));
                         }
-                        let (part, payload) = run.run_shard(&mut ws, *index, *count, progress)?;
-                        let header = ShardHeader {
-                            bake: shard::bake_id(pipeline)?,
-                            stage: name.into(),
-                            index: *index as u32,
-                            count: *count as u32,
-                            key: key.clone(),
-                            relume_version: env!("CARGO_PKG_VERSION").into(),
-                            pipeline: pipeline.clone(),
-                            part: part.clone(),
-                            facts: Default::default(),
-                            sections: Vec::new(),
-                            payload_bytes: 0,
-                            payload_sha256: String::new(),
+                        let at = shard::ShardAt {
+                            pipeline,
+                            stage: name,
+                            key: &key,
+                            index: *index,
+                            count: *count,
+                            dir,
                         };
-                        let path = crate::baked::shard::write(dir, header, &payload)?;
+                        let written = at.compute(run, &mut ws, progress)?;
                         let mut tm = timing(&records[0], t, false);
                         tm.stage = name.into();
-                        tm.outputs = vec![path.display().to_string()];
+                        tm.outputs = vec![written.path.display().to_string()];
                         tm.peak_rss_bytes = limits::peak_rss();
                         timings.push(tm);
-                        return Ok(partial_report(
-                            output,
-                            timings,
-                            warnings,
-                            estimated_peak,
-                            Some(ShardWritten {
-                                stage: name.into(),
-                                index: *index,
-                                count: *count,
-                                part,
-                                path,
-                            }),
-                            None,
-                        ));
+                        let report = partial_report(output, timings, warnings, estimated_peak);
+                        return Ok(BakeReport {
+                            shard: Some(written),
+                            ..report
+                        });
                     }
                     (Sharding::Merge { .. }, true) => {
                         let set = merge_set.as_ref().expect("scanned for a merge");
-                        let Some(paths) = set.complete(name, &key)? else {
-                            return Ok(partial_report(
-                                output,
-                                timings,
-                                warnings,
-                                estimated_peak,
-                                None,
-                                Some(name.into()),
-                            ));
+                        let Some(shards) = set.payloads(name, &key)? else {
+                            let report = partial_report(output, timings, warnings, estimated_peak);
+                            return Ok(BakeReport {
+                                needs_shards: Some(name.into()),
+                                ..report
+                            });
                         };
-                        let mut shards = Vec::with_capacity(paths.len());
-                        for p in paths {
-                            let (_, payload) = crate::baked::shard::read(&p)?;
-                            shards.push((p, payload));
-                        }
                         run.merge_shards(&mut ws, &mut txn, shards)?
                     }
                     _ => run.run(&mut ws, &mut txn, progress)?,
@@ -274,14 +242,7 @@ pub fn run_pipeline(
 
     if matches!(opts.sharding, Sharding::Shard { .. }) {
         // Every stage was in the cache: nothing to shard, the output is the merge's to write.
-        return Ok(partial_report(
-            output,
-            timings,
-            warnings,
-            estimated_peak,
-            None,
-            None,
-        ));
+        return Ok(partial_report(output, timings, warnings, estimated_peak));
     }
     let (bytes, sha256) = hash_file(pipeline.input.path())?;
     let input_name = pipeline
@@ -336,8 +297,6 @@ fn partial_report(
     stages: Vec<StageTiming>,
     warnings: Vec<String>,
     estimated_peak_bytes: u64,
-    shard: Option<ShardWritten>,
-    needs_shards: Option<String>,
 ) -> BakeReport {
     BakeReport {
         output: output.to_path_buf(),
@@ -347,8 +306,8 @@ fn partial_report(
         files: Vec::new(),
         warnings,
         estimated_peak_bytes,
-        shard,
-        needs_shards,
+        shard: None,
+        needs_shards: None,
     }
 }
 

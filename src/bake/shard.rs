@@ -8,10 +8,13 @@
 //! columns). Everything else runs in each shard (cheap stages before, taken from the cache when
 //! there) or in the merge (cheap stages after).
 
+use super::stages::StageRun;
+use super::workspace::Workspace;
 use crate::baked::manifest::{hash_file, sha256_hex};
-use crate::baked::shard::{self, ShardHeader};
+use crate::baked::shard::{self, Payload, ShardHeader};
 use crate::error::{Error, Result};
 use crate::pipeline::Pipeline;
+use crate::progress::Progress;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -40,6 +43,75 @@ pub struct ShardWritten {
     pub count: usize,
     pub part: String,
     pub path: PathBuf,
+    /// The file was already there, made from the same inputs, and verified: nothing was computed.
+    pub reused: bool,
+}
+
+/// The header of the shard at `path` when it exists, belongs to bake `bake`, has stage key
+/// `key` and verifies whole (payload hash); `None` otherwise.
+pub fn intact(path: &Path, bake: &str, key: &str) -> Option<ShardHeader> {
+    let h = shard::read_header(path).ok()?;
+    if h.bake != bake || h.key != key {
+        return None;
+    }
+    shard::read(path).ok().map(|(h, _)| h)
+}
+
+/// Where one shard of a stage goes, and what it is made from.
+pub struct ShardAt<'a> {
+    pub pipeline: &'a Pipeline,
+    pub stage: &'a str,
+    /// The stage's cache key.
+    pub key: &'a str,
+    pub index: usize,
+    pub count: usize,
+    pub dir: &'a Path,
+}
+
+impl ShardAt<'_> {
+    /// Compute the shard with `run` and write it — or, when an intact shard made from the same
+    /// inputs is already there (a retried or resubmitted task), keep it.
+    pub fn compute(
+        &self,
+        run: &dyn StageRun,
+        ws: &mut Workspace,
+        progress: &dyn Progress,
+    ) -> Result<ShardWritten> {
+        let bake = bake_id(self.pipeline)?;
+        let path = self.dir.join(shard::file_name(
+            self.stage,
+            self.index as u32,
+            self.count as u32,
+        ));
+        let written = |part: String, path: PathBuf, reused: bool| ShardWritten {
+            stage: self.stage.into(),
+            index: self.index,
+            count: self.count,
+            part,
+            path,
+            reused,
+        };
+        if let Some(h) = intact(&path, &bake, self.key) {
+            return Ok(written(h.part, path, true));
+        }
+        let (part, payload) = run.run_shard(ws, self.index, self.count, progress)?;
+        let header = ShardHeader {
+            bake,
+            stage: self.stage.into(),
+            index: self.index as u32,
+            count: self.count as u32,
+            key: self.key.into(),
+            relume_version: env!("CARGO_PKG_VERSION").into(),
+            pipeline: self.pipeline.clone(),
+            part: part.clone(),
+            facts: Default::default(),
+            sections: Vec::new(),
+            payload_bytes: 0,
+            payload_sha256: String::new(),
+        };
+        let path = shard::write(self.dir, header, &payload)?;
+        Ok(written(part, path, false))
+    }
 }
 
 /// Which bake shards belong to: the pipeline and the input file's content.
@@ -118,6 +190,20 @@ impl ShardSet {
     /// The pipeline the shards were made from.
     pub fn pipeline(&self) -> &Pipeline {
         &self.headers[0].1.pipeline
+    }
+
+    /// The arrays of the complete set of shards of `stage` (see [`ShardSet::complete`]), each
+    /// verified whole, in index order; `None` when there is no shard of `stage` at all.
+    pub fn payloads(&self, stage: &str, key: &str) -> Result<Option<Vec<(PathBuf, Payload)>>> {
+        let Some(paths) = self.complete(stage, key)? else {
+            return Ok(None);
+        };
+        let mut out = Vec::with_capacity(paths.len());
+        for p in paths {
+            let (_, payload) = shard::read(&p)?;
+            out.push((p, payload));
+        }
+        Ok(Some(out))
     }
 
     /// The complete, consistent set of shards of `stage` with cache key `key`, in index order;

@@ -18,12 +18,13 @@
 
 use super::infinite::{from_fn_tiled, infinite, to_row_major, RowMajor, F32_BYTES_PER_ENTRY};
 pub use super::infinite::{spectral_bounds, spectral_bounds_rows, InfiniteSolver, F32_ACCEPT};
+use super::lu_panels::par;
 use super::TransportMatrix;
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::progress::Progress;
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, Par};
+use faer::{Accum, Mat};
 use serde::{Deserialize, Serialize};
 
 /// How many bounces the transport matrix accumulates.
@@ -208,10 +209,6 @@ fn refuse_divergent(bounds: (f64, f64), what: &str) -> Result<()> {
         )));
     }
     Ok(())
-}
-
-fn par() -> Par {
-    Par::rayon(0)
 }
 
 /// `dst = a · b` (Accum::Replace) or `dst += a · b` (Accum::Add).

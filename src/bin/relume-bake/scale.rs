@@ -83,7 +83,12 @@ pub struct MergeArgs {
 pub fn summary(report: &BakeReport, out: &Path) -> Option<String> {
     if let Some(s) = &report.shard {
         return Some(format!(
-            "wrote shard {}/{} of `{}` ({}): {}\n",
+            "{} shard {}/{} of `{}` ({}): {}\n",
+            if s.reused {
+                "already there, verified:"
+            } else {
+                "wrote"
+            },
             s.index,
             s.count,
             s.stage,
