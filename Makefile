@@ -6,7 +6,7 @@ BAKE     := target/release/relume-bake
 PLAYER   := target/release/relume-player
 SUDO     := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PKGS := mesa-vulkan-drivers libvulkan1 libstdc++-12-dev xvfb xauth gdal-bin slurm-wlm munge
-PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder rasterio embreex mitsuba
+PY_PKGS  := pillow numpy openexr tifffile texture2ddecoder rasterio embreex mitsuba pyyaml
 export WGPU_BACKEND ?= vulkan
 # Mesa warns without a private runtime dir; give it one.
 export XDG_RUNTIME_DIR ?= /tmp/relume-xdg-$(shell id -u)
@@ -147,9 +147,9 @@ deps-apt:
 	fi
 
 deps-py:
-	@python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex, mitsuba" 2>/dev/null || { \
+	@python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex, mitsuba, yaml" 2>/dev/null || { \
 	  python3 -m pip install --quiet --disable-pip-version-check $(PY_PKGS) && \
-	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex, mitsuba"; } || \
+	  python3 -c "import PIL, numpy, OpenEXR, tifffile, texture2ddecoder, rasterio, embreex, mitsuba, yaml"; } || \
 	  { echo "error: cannot install the Python cross-check readers ($(PY_PKGS))" >&2; exit 1; }
 
 ## The Khronos glTF-Validator for the glTF export's test (Node and npm; pinned in tools/npm).

@@ -209,7 +209,13 @@ fn owner_alive(tag: &str) -> bool {
 /// runs? Its `.relume-lock` names the writer (`PID START`); without one, the PID in the name does.
 /// Never true for this process.
 pub(crate) fn left_by_dead_process(dir: &Path, pid: u32) -> bool {
-    let tag = std::fs::read_to_string(dir.join(LOCK)).unwrap_or_else(|_| format!("{pid}"));
+    // A lock still being written reads empty: then the name's PID answers (concurrent shard
+    // processes beside one output start at the same moment; an empty tag once counted as dead
+    // and a live process's directory was removed under it).
+    let tag = std::fs::read_to_string(dir.join(LOCK))
+        .ok()
+        .filter(|t| !t.trim().is_empty())
+        .unwrap_or_else(|| format!("{pid}"));
     pid != std::process::id() && !owner_alive(&tag)
 }
 
