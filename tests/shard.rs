@@ -13,7 +13,7 @@ use relume::radiosity::formfactor::{
     assemble, form_factor_rows, form_factors, shard_rows, Estimator, FormFactorParams,
 };
 use relume::radiosity::transport::{transport, Bounces, Power, TransportParams};
-use relume::radiosity::transport_shard::{assemble_infinite, infinite_part};
+use relume::radiosity::transport_shard::{assemble_infinite, factor_channels, solve_part};
 use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
@@ -426,13 +426,13 @@ fn row_blocks_and_transport_parts_assemble_exactly_for_any_split() {
         &Silent,
     )
     .unwrap();
+    let factors = factor_channels(&f.values, &albedo, Default::default(), u64::MAX).unwrap();
+    let solvers: Vec<_> = factors.iter().map(|c| (c.solver, c.error)).collect();
     for count in [1, 2, 3, 16, 40] {
         let parts: Vec<_> = (0..count)
-            .map(|i| {
-                infinite_part(&f.values, &albedo, Default::default(), u64::MAX, i, count).unwrap()
-            })
+            .map(|i| solve_part(&f.values, &albedo, &factors, i, count).unwrap())
             .collect();
-        let got = assemble_infinite(&f.values, &albedo, parts).unwrap();
+        let got = assemble_infinite(&f.values, &albedo, &solvers, parts).unwrap();
         assert!(got == whole, "transport in {count} parts");
     }
 }

@@ -209,13 +209,21 @@ pub fn run_pipeline(
                     (Sharding::Merge { .. }, true) => {
                         let set = merge_set.as_ref().expect("scanned for a merge");
                         let Some(shards) = set.payloads(name, &key)? else {
+                            // The next round: what its shards share is made here, once.
+                            if let Some(p) = run.prepare_shards(&mut ws)? {
+                                let Sharding::Merge { dirs } = &opts.sharding else {
+                                    unreachable!()
+                                };
+                                shard::write_prepared(&dirs[0], pipeline, name, &key, &p)?;
+                            }
                             let report = partial_report(output, timings, warnings, estimated_peak);
                             return Ok(BakeReport {
                                 needs_shards: Some(name.into()),
                                 ..report
                             });
                         };
-                        run.merge_shards(&mut ws, &mut txn, shards)?
+                        let prepared = set.prepared(name, &key)?;
+                        run.merge_shards(&mut ws, &mut txn, shards, prepared)?
                     }
                     _ => run.run(&mut ws, &mut txn, progress)?,
                 };

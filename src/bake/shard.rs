@@ -94,7 +94,8 @@ impl ShardAt<'_> {
         if let Some(h) = intact(&path, &bake, self.key) {
             return Ok(written(h.part, path, true));
         }
-        let (part, payload) = run.run_shard(ws, self.index, self.count, progress)?;
+        let prepared = read_prepared(self.dir, self.stage, self.key, &bake)?;
+        let (part, payload) = run.run_shard(ws, self.index, self.count, prepared, progress)?;
         let header = ShardHeader {
             bake,
             stage: self.stage.into(),
@@ -112,6 +113,59 @@ impl ShardAt<'_> {
         let path = shard::write(self.dir, header, &payload)?;
         Ok(written(part, path, false))
     }
+}
+
+/// The stage name under which the work done once before a stage's shards is stored
+/// (`transport-prepared.0-of-1.shard`: the LU factors).
+pub fn prepared_name(stage: &str) -> String {
+    format!("{stage}-prepared")
+}
+
+/// The prepared arrays of `stage` in `dir`, verified whole and checked to be of this bake and
+/// stage key; `None` when there is no such file.
+pub fn read_prepared(
+    dir: &Path,
+    stage: &str,
+    key: &str,
+    bake: &str,
+) -> Result<Option<(PathBuf, Payload)>> {
+    let path = dir.join(shard::file_name(&prepared_name(stage), 0, 1));
+    if !path.exists() {
+        return Ok(None);
+    }
+    let (h, payload) = shard::read(&path)?;
+    if h.bake != bake || h.key != key {
+        return Err(Error::verify(
+            &path,
+            format!("made for another bake or other inputs of `{stage}`: run the merge of the previous round again"),
+        ));
+    }
+    Ok(Some((path, payload)))
+}
+
+/// Store what `stage`'s shards need, made once by the merge of the previous round.
+pub fn write_prepared(
+    dir: &Path,
+    pipeline: &Pipeline,
+    stage: &str,
+    key: &str,
+    payload: &Payload,
+) -> Result<PathBuf> {
+    let header = ShardHeader {
+        bake: bake_id(pipeline)?,
+        stage: prepared_name(stage),
+        index: 0,
+        count: 1,
+        key: key.into(),
+        relume_version: env!("CARGO_PKG_VERSION").into(),
+        pipeline: pipeline.clone(),
+        part: format!("prepared once for the shards of `{stage}`"),
+        facts: Default::default(),
+        sections: Vec::new(),
+        payload_bytes: 0,
+        payload_sha256: String::new(),
+    };
+    shard::write(dir, header, payload)
 }
 
 /// Which bake shards belong to: the pipeline and the input file's content.
@@ -185,6 +239,18 @@ impl ShardSet {
             ));
         }
         Ok(ShardSet { headers })
+    }
+
+    /// The prepared arrays of `stage` (see [`read_prepared`]) from whichever directory holds them.
+    pub fn prepared(&self, stage: &str, key: &str) -> Result<Option<(PathBuf, Payload)>> {
+        let name = prepared_name(stage);
+        match self.headers.iter().find(|(_, h)| h.stage == name) {
+            Some((p, h)) => {
+                let dir = p.parent().unwrap_or(Path::new("."));
+                read_prepared(dir, stage, key, &h.bake)
+            }
+            None => Ok(None),
+        }
     }
 
     /// The pipeline the shards were made from.

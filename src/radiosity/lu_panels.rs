@@ -152,6 +152,37 @@ impl<T: Real> Factored<T> {
         self.perm.len()
     }
 
+    /// The packed factors (column-major, L strictly below the diagonal, U on and above) and the
+    /// row permutation, to be stored and read back by [`Factored::from_parts`].
+    pub fn to_parts(&self) -> (Vec<T>, Vec<u64>) {
+        let n = self.n();
+        let mut lu = Vec::with_capacity(n * n);
+        for j in 0..n {
+            lu.extend_from_slice(self.lu.col_as_slice(j));
+        }
+        (lu, self.perm.iter().map(|&p| p as u64).collect())
+    }
+
+    /// Factors stored by [`Factored::to_parts`]; `None` when the sizes do not agree or the
+    /// permutation is not one.
+    pub fn from_parts(lu: &[T], perm: &[u64]) -> Option<Self> {
+        let n = perm.len();
+        if lu.len() != n * n {
+            return None;
+        }
+        let mut seen = vec![false; n];
+        for &p in perm {
+            let p = p as usize;
+            if p >= n || std::mem::replace(&mut seen[p], true) {
+                return None;
+            }
+        }
+        Some(Factored {
+            lu: Mat::from_fn(n, n, |i, j| lu[j * n + i]),
+            perm: perm.iter().map(|&p| p as usize).collect(),
+        })
+    }
+
     /// `A⁻¹ B` for k right-hand sides in working precision; `b` and the result are row-major
     /// `[n, k]`.
     pub fn solve_many(&self, b: &[f64], k: usize) -> Vec<f64> {

@@ -34,12 +34,20 @@ pub trait StageRun {
         false
     }
 
-    /// Compute shard `index` of `count`: what part it is (for people), and its arrays.
+    /// Work that one process does once before the shards of this stage (the merge that ends the
+    /// previous round): arrays every shard reads (the transport's LU factors).
+    fn prepare_shards(&self, _ws: &mut Workspace) -> Result<Option<Payload>> {
+        Ok(None)
+    }
+
+    /// Compute shard `index` of `count` (with what [`StageRun::prepare_shards`] made): what
+    /// part it is (for people), and its arrays.
     fn run_shard(
         &self,
         _ws: &mut Workspace,
         _index: usize,
         _count: usize,
+        _prepared: Option<(PathBuf, Payload)>,
         _progress: &dyn Progress,
     ) -> Result<(String, Payload)> {
         Err(crate::error::Error::Internal(
@@ -54,6 +62,7 @@ pub trait StageRun {
         _ws: &mut Workspace,
         _txn: &mut BakeTransaction,
         _shards: Vec<(PathBuf, Payload)>,
+        _prepared: Option<(PathBuf, Payload)>,
     ) -> Result<StageRecord> {
         Err(crate::error::Error::Internal(
             "this stage has no shards".into(),

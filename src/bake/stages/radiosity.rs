@@ -11,14 +11,15 @@ use crate::progress::Progress;
 use crate::radiosity::formfactor::{
     assemble, form_factor_rows, form_factors, shard_rows, Estimator, FormFactors, RowBlock,
 };
-use crate::radiosity::infinite::InfiniteSolver;
+use crate::radiosity::infinite::{InfiniteFactor, InfiniteSolver};
+use crate::radiosity::lu_panels::Factored;
 use crate::radiosity::lu_panels::{panel_count, Panel};
 use crate::radiosity::transport::{
     memory_estimate, transport, Bounces, Transport, TransportParams,
 };
 use crate::radiosity::transport_shard::{
-    assemble_infinite, channels as transport_channels, infinite_part, part_memory, part_panels,
-    ChannelPart,
+    assemble_infinite, channels as transport_channels, factor_channels, part_memory, part_panels,
+    solve_part, ChannelFactors, ChannelPart,
 };
 use crate::radiosity::voxelize::{voxelize_noting, Resolution};
 use std::path::PathBuf;
@@ -137,6 +138,7 @@ impl StageRun for FormFactorsKnobs {
         ws: &mut Workspace,
         index: usize,
         count: usize,
+        _prepared: Option<(PathBuf, Payload)>,
         progress: &dyn Progress,
     ) -> Result<(String, Payload)> {
         let (scene, set) = ws.scene_and_patches()?;
@@ -165,6 +167,7 @@ impl StageRun for FormFactorsKnobs {
         ws: &mut Workspace,
         txn: &mut BakeTransaction,
         shards: Vec<(PathBuf, Payload)>,
+        _prepared: Option<(PathBuf, Payload)>,
     ) -> Result<StageRecord> {
         let budget = ws.memory_budget();
         let set = ws.patches()?;
@@ -330,31 +333,58 @@ impl StageRun for TransportKnobs {
         self.bounces == Bounces::Infinite
     }
 
+    fn prepare_shards(&self, ws: &mut Workspace) -> Result<Option<Payload>> {
+        let budget = ws.memory_budget();
+        let albedo = albedos(ws.patches()?);
+        let f = ws.form_factors_mapped()?;
+        check_shape(f.n(), albedo.len())?;
+        let factors = factor_channels(f.values(), &albedo, Default::default(), budget)?;
+        let mut p = Payload::default();
+        for (c, fc) in factors.into_iter().enumerate() {
+            p.f64s.insert(format!("error_{c}"), vec![fc.error]);
+            p.u32s.insert(format!("solver_{c}"), vec![fc.solver as u32]);
+            let perm = match fc.factor {
+                InfiniteFactor::F32(lu) => {
+                    let (v, perm) = lu.to_parts();
+                    p.f32s.insert(format!("lu_{c}"), v);
+                    perm
+                }
+                InfiniteFactor::F64(lu) => {
+                    let (v, perm) = lu.to_parts();
+                    p.f64s.insert(format!("lu_{c}"), v);
+                    perm
+                }
+            };
+            p.u64s.insert(format!("perm_{c}"), perm);
+        }
+        Ok(Some(p))
+    }
+
     fn run_shard(
         &self,
         ws: &mut Workspace,
         index: usize,
         count: usize,
+        prepared: Option<(PathBuf, Payload)>,
         _progress: &dyn Progress,
     ) -> Result<(String, Payload)> {
-        let budget = ws.memory_budget();
         let albedo = albedos(ws.patches()?);
         let n = albedo.len();
+        let (path, mut prepared) = prepared.ok_or_else(|| {
+            Error::verify(
+                "transport-prepared.0-of-1.shard",
+                "the transport's shards need the factors that `relume-bake merge` writes into the shard directory after merging the form factors: run that merge first",
+            )
+        })?;
         let f = ws.form_factors_mapped()?;
         check_shape(f.n(), n)?;
-        let parts = infinite_part(
-            f.values(),
-            &albedo,
-            Default::default(),
-            budget,
-            index,
-            count,
-        )?;
+        let channels = transport_channels(&albedo);
+        let factors = (0..channels)
+            .map(|c| read_factors(&mut prepared, &path, c, n))
+            .collect::<Result<Vec<_>>>()?;
+        let parts = solve_part(f.values(), &albedo, &factors, index, count)?;
         let mut p = Payload::default();
         for (c, part) in parts.into_iter().enumerate() {
-            p.f64s.insert(format!("error_{c}"), vec![part.error]);
-            p.u32s
-                .insert(format!("solver_{c}"), vec![part.solver as u32]);
             let (cols, vals): (Vec<Vec<u32>>, Vec<Vec<f32>>) = part
                 .panels
                 .into_iter()
@@ -370,7 +400,7 @@ impl StageRun for TransportKnobs {
         let r = part_panels(n, index, count);
         Ok((
             format!(
-                "panels {}..{} of {} (n = {n})",
+                "panels {}..{} of {}, n = {n}",
                 r.start,
                 r.end,
                 panel_count(n)
@@ -384,23 +414,27 @@ impl StageRun for TransportKnobs {
         ws: &mut Workspace,
         txn: &mut BakeTransaction,
         shards: Vec<(PathBuf, Payload)>,
+        prepared: Option<(PathBuf, Payload)>,
     ) -> Result<StageRecord> {
         let albedo = albedos(ws.patches()?);
         let n = albedo.len();
+        let (ppath, mut prepared) = prepared.ok_or_else(|| {
+            Error::verify(
+                "transport-prepared.0-of-1.shard",
+                "missing beside the transport's shards (the merge of the previous round writes it)",
+            )
+        })?;
+        let channels = transport_channels(&albedo);
+        let solvers = (0..channels)
+            .map(|c| read_solver(&mut prepared, &ppath, c))
+            .collect::<Result<Vec<_>>>()?;
+        drop(prepared);
         let f = ws.form_factors()?;
         check_shape(f.n, n)?;
-        let channels = transport_channels(&albedo);
         let mut parts = Vec::with_capacity(shards.len());
         for (path, mut p) in shards {
             let mut part = Vec::with_capacity(channels);
             for c in 0..channels {
-                let solver = match p.u32s(&format!("solver_{c}"), &path)?.first() {
-                    Some(0) => InfiniteSolver::Auto,
-                    Some(1) => InfiniteSolver::F32,
-                    Some(2) => InfiniteSolver::F64,
-                    other => return Err(Error::verify(&path, format!("unknown solver {other:?}"))),
-                };
-                let error = p.f64s(&format!("error_{c}"), &path)?[0];
                 let widths = p.u64s(&format!("panel_widths_{c}"), &path)?;
                 let cols = p.u32s(&format!("columns_{c}"), &path)?;
                 let vals = p.f32s(&format!("values_{c}"), &path)?;
@@ -421,15 +455,11 @@ impl StageRun for TransportKnobs {
                     });
                     at += w;
                 }
-                part.push(ChannelPart {
-                    solver,
-                    error,
-                    panels,
-                });
+                part.push(ChannelPart { panels });
             }
             parts.push(part);
         }
-        let t = assemble_infinite(&f.values, &albedo, parts)?;
+        let t = assemble_infinite(&f.values, &albedo, &solvers, parts)?;
         self.finish(ws, txn, n, t)
     }
 
@@ -510,4 +540,53 @@ fn check_shape(f_n: usize, n: usize) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The solver and estimated error of channel `c` from the transport's prepared factors.
+fn read_solver(p: &mut Payload, path: &std::path::Path, c: usize) -> Result<(InfiniteSolver, f64)> {
+    let solver = match p.u32s(&format!("solver_{c}"), path)?.first() {
+        Some(0) => InfiniteSolver::Auto,
+        Some(1) => InfiniteSolver::F32,
+        Some(2) => InfiniteSolver::F64,
+        other => return Err(Error::verify(path, format!("unknown solver {other:?}"))),
+    };
+    let error = p
+        .f64s(&format!("error_{c}"), path)?
+        .first()
+        .copied()
+        .unwrap_or(f64::NAN);
+    Ok((solver, error))
+}
+
+/// Channel `c`'s factors from the transport's prepared factors.
+fn read_factors(
+    p: &mut Payload,
+    path: &std::path::Path,
+    c: usize,
+    n: usize,
+) -> Result<ChannelFactors> {
+    let (solver, error) = read_solver(p, path, c)?;
+    let perm = p.u64s(&format!("perm_{c}"), path)?;
+    let bad = || {
+        Error::verify(
+            path,
+            format!("the factors of channel {c} are not {n} x {n}"),
+        )
+    };
+    if perm.len() != n {
+        return Err(bad());
+    }
+    let factor = match solver {
+        InfiniteSolver::F64 => InfiniteFactor::F64(
+            Factored::from_parts(&p.f64s(&format!("lu_{c}"), path)?, &perm).ok_or_else(bad)?,
+        ),
+        _ => InfiniteFactor::F32(
+            Factored::from_parts(&p.f32s(&format!("lu_{c}"), path)?, &perm).ok_or_else(bad)?,
+        ),
+    };
+    Ok(ChannelFactors {
+        factor,
+        solver,
+        error,
+    })
 }
