@@ -430,7 +430,13 @@ fn row_blocks_and_transport_parts_assemble_exactly_for_any_split() {
     let solvers: Vec<_> = factors.iter().map(|c| (c.solver, c.error)).collect();
     for count in [1, 2, 3, 16, 40] {
         let parts: Vec<_> = (0..count)
-            .map(|i| solve_part(&f.values, &albedo, &factors, i, count).unwrap())
+            .map(|i| {
+                factors
+                    .iter()
+                    .enumerate()
+                    .map(|(c, fc)| solve_part(&f.values, &albedo, c, fc, i, count).unwrap())
+                    .collect()
+            })
             .collect();
         let got = assemble_infinite(&f.values, &albedo, &solvers, parts).unwrap();
         assert!(got == whole, "transport in {count} parts");

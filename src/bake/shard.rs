@@ -11,7 +11,7 @@
 use super::stages::StageRun;
 use super::workspace::Workspace;
 use crate::baked::manifest::{hash_file, sha256_hex};
-use crate::baked::shard::{self, Payload, ShardHeader};
+use crate::baked::shard::{self, Mapped, Payload, ShardHeader};
 use crate::error::{Error, Result};
 use crate::pipeline::Pipeline;
 use crate::progress::Progress;
@@ -123,24 +123,20 @@ pub fn prepared_name(stage: &str) -> String {
 
 /// The prepared arrays of `stage` in `dir`, verified whole and checked to be of this bake and
 /// stage key; `None` when there is no such file.
-pub fn read_prepared(
-    dir: &Path,
-    stage: &str,
-    key: &str,
-    bake: &str,
-) -> Result<Option<(PathBuf, Payload)>> {
+pub fn read_prepared(dir: &Path, stage: &str, key: &str, bake: &str) -> Result<Option<Mapped>> {
     let path = dir.join(shard::file_name(&prepared_name(stage), 0, 1));
     if !path.exists() {
         return Ok(None);
     }
-    let (h, payload) = shard::read(&path)?;
+    let mapped = Mapped::open(&path)?;
+    let h = &mapped.header;
     if h.bake != bake || h.key != key {
         return Err(Error::verify(
             &path,
             format!("made for another bake or other inputs of `{stage}`: run the merge of the previous round again"),
         ));
     }
-    Ok(Some((path, payload)))
+    Ok(Some(mapped))
 }
 
 /// Store what `stage`'s shards need, made once by the merge of the previous round.
@@ -242,7 +238,7 @@ impl ShardSet {
     }
 
     /// The prepared arrays of `stage` (see [`read_prepared`]) from whichever directory holds them.
-    pub fn prepared(&self, stage: &str, key: &str) -> Result<Option<(PathBuf, Payload)>> {
+    pub fn prepared(&self, stage: &str, key: &str) -> Result<Option<Mapped>> {
         let name = prepared_name(stage);
         match self.headers.iter().find(|(_, h)| h.stage == name) {
             Some((p, h)) => {

@@ -300,3 +300,100 @@ pub fn read(path: &Path) -> Result<(ShardHeader, Payload)> {
     }
     Ok((header, payload))
 }
+
+/// A shard file memory-mapped, its payload verified: sections are copied out one at a time, so
+/// that a reader of large arrays (the transport's LU factors) holds one of them at once.
+pub struct Mapped {
+    map: memmap2::Mmap,
+    start: usize,
+    pub header: ShardHeader,
+    path: PathBuf,
+}
+
+impl Mapped {
+    /// Map `path`, check its header and its payload's SHA-256.
+    pub fn open(path: &Path) -> Result<Self> {
+        let header = read_header(path)?;
+        let file = std::fs::File::open(path).at(path, "cannot read the shard")?;
+        // SAFETY: shard files are written once and renamed into place, never changed in place.
+        let map = unsafe { memmap2::Mmap::map(&file) }.at(path, "cannot map the shard")?;
+        let start = map.len() - header.payload_bytes as usize;
+        if sha256_hex(&map[start..]) != header.payload_sha256 {
+            return Err(Error::verify(
+                path,
+                "damaged: the payload does not match its SHA-256",
+            ));
+        }
+        Ok(Mapped {
+            map,
+            start,
+            header,
+            path: path.to_path_buf(),
+        })
+    }
+
+    fn section(&self, name: &str, dtype: &str) -> Result<&[u8]> {
+        let mut at = self.start;
+        for s in &self.header.sections {
+            let width = if s.dtype == "f64" || s.dtype == "u64" {
+                8
+            } else {
+                4
+            };
+            let end = at + s.len as usize * width;
+            if s.name == name {
+                if s.dtype != dtype {
+                    return Err(Error::verify(
+                        &self.path,
+                        format!("section `{name}` is {}, not {dtype}", s.dtype),
+                    ));
+                }
+                return self
+                    .map
+                    .get(at..end)
+                    .ok_or_else(|| Error::verify(&self.path, "the sections run past the payload"));
+            }
+            at = end;
+        }
+        Err(Error::verify(
+            &self.path,
+            format!("the shard has no section `{name}`"),
+        ))
+    }
+
+    /// Does the shard have a section `name` of type `dtype`?
+    pub fn has(&self, name: &str, dtype: &str) -> bool {
+        self.header
+            .sections
+            .iter()
+            .any(|s| s.name == name && s.dtype == dtype)
+    }
+
+    pub fn f32s(&self, name: &str) -> Result<Vec<f32>> {
+        let b = self.section(name, "f32")?;
+        Ok(b.chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect())
+    }
+    pub fn f64s(&self, name: &str) -> Result<Vec<f64>> {
+        let b = self.section(name, "f64")?;
+        Ok(b.chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect())
+    }
+    pub fn u32s(&self, name: &str) -> Result<Vec<u32>> {
+        let b = self.section(name, "u32")?;
+        Ok(b.chunks_exact(4)
+            .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+            .collect())
+    }
+    pub fn u64s(&self, name: &str) -> Result<Vec<u64>> {
+        let b = self.section(name, "u64")?;
+        Ok(b.chunks_exact(8)
+            .map(|c| u64::from_le_bytes(c.try_into().unwrap()))
+            .collect())
+    }
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}

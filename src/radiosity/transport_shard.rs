@@ -86,32 +86,26 @@ pub fn factor_channels(
         .collect()
 }
 
-/// Part `index` of `count` of `S_∞` from the factors of every channel.
+/// Channel `c`'s part `index` of `count` of `S_∞` from that channel's factors.
 pub fn solve_part(
     f: &[f32],
     albedo: &[[f32; 3]],
-    factors: &[ChannelFactors],
+    c: usize,
+    factors: &ChannelFactors,
     index: usize,
     count: usize,
-) -> Result<Vec<ChannelPart>> {
+) -> Result<ChannelPart> {
     let n = albedo.len();
-    if index >= count || factors.len() != channels(albedo) {
+    if index >= count || c >= channels(albedo) {
         return Err(Error::Internal(format!(
-            "transport part {index}/{count} with {} channel factors",
-            factors.len()
+            "transport part {index}/{count} of channel {c}"
         )));
     }
-    factors
-        .iter()
-        .enumerate()
-        .map(|(c, fc)| {
-            let rho = rho(albedo, c);
-            let panels = fc
-                .factor
-                .solve_panels(part_panels(n, index, count), RowMajor { f, rho: &rho })?;
-            Ok(ChannelPart { panels })
-        })
-        .collect()
+    let rho = rho(albedo, c);
+    let panels = factors
+        .factor
+        .solve_panels(part_panels(n, index, count), RowMajor { f, rho: &rho })?;
+    Ok(ChannelPart { panels })
 }
 
 /// The transport from the factors and every part, in index order (`parts[i]` = part i of

@@ -8,7 +8,7 @@ mod terrain;
 
 use super::estimate::{PlanState, PlannedStage};
 use super::workspace::Workspace;
-use crate::baked::shard::Payload;
+use crate::baked::shard::{Mapped, Payload};
 use crate::baked::{BakeTransaction, StageRecord};
 use crate::error::Result;
 use crate::pipeline::Stage;
@@ -47,7 +47,7 @@ pub trait StageRun {
         _ws: &mut Workspace,
         _index: usize,
         _count: usize,
-        _prepared: Option<(PathBuf, Payload)>,
+        _prepared: Option<Mapped>,
         _progress: &dyn Progress,
     ) -> Result<(String, Payload)> {
         Err(crate::error::Error::Internal(
@@ -62,7 +62,7 @@ pub trait StageRun {
         _ws: &mut Workspace,
         _txn: &mut BakeTransaction,
         _shards: Vec<(PathBuf, Payload)>,
-        _prepared: Option<(PathBuf, Payload)>,
+        _prepared: Option<Mapped>,
     ) -> Result<StageRecord> {
         Err(crate::error::Error::Internal(
             "this stage has no shards".into(),

@@ -3,7 +3,7 @@
 use super::{record, StageRun};
 use crate::bake::estimate::{PlanState, PlannedStage};
 use crate::bake::workspace::Workspace;
-use crate::baked::shard::Payload;
+use crate::baked::shard::{Mapped, Payload};
 use crate::baked::{self, form_factors::FormFactorMatrix, BakeTransaction, StageRecord};
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
@@ -138,7 +138,7 @@ impl StageRun for FormFactorsKnobs {
         ws: &mut Workspace,
         index: usize,
         count: usize,
-        _prepared: Option<(PathBuf, Payload)>,
+        _prepared: Option<Mapped>,
         progress: &dyn Progress,
     ) -> Result<(String, Payload)> {
         let (scene, set) = ws.scene_and_patches()?;
@@ -167,7 +167,7 @@ impl StageRun for FormFactorsKnobs {
         ws: &mut Workspace,
         txn: &mut BakeTransaction,
         shards: Vec<(PathBuf, Payload)>,
-        _prepared: Option<(PathBuf, Payload)>,
+        _prepared: Option<Mapped>,
     ) -> Result<StageRecord> {
         let budget = ws.memory_budget();
         let set = ws.patches()?;
@@ -365,12 +365,12 @@ impl StageRun for TransportKnobs {
         ws: &mut Workspace,
         index: usize,
         count: usize,
-        prepared: Option<(PathBuf, Payload)>,
+        prepared: Option<Mapped>,
         _progress: &dyn Progress,
     ) -> Result<(String, Payload)> {
         let albedo = albedos(ws.patches()?);
         let n = albedo.len();
-        let (path, mut prepared) = prepared.ok_or_else(|| {
+        let prepared = prepared.ok_or_else(|| {
             Error::verify(
                 "transport-prepared.0-of-1.shard",
                 "the transport's shards need the factors that `relume-bake merge` writes into the shard directory after merging the form factors: run that merge first",
@@ -379,12 +379,11 @@ impl StageRun for TransportKnobs {
         let f = ws.form_factors_mapped()?;
         check_shape(f.n(), n)?;
         let channels = transport_channels(&albedo);
-        let factors = (0..channels)
-            .map(|c| read_factors(&mut prepared, &path, c, n))
-            .collect::<Result<Vec<_>>>()?;
-        let parts = solve_part(f.values(), &albedo, &factors, index, count)?;
         let mut p = Payload::default();
-        for (c, part) in parts.into_iter().enumerate() {
+        for c in 0..channels {
+            // One channel's factors at a time.
+            let factors = read_factors(&prepared, c, n)?;
+            let part = solve_part(f.values(), &albedo, c, &factors, index, count)?;
             let (cols, vals): (Vec<Vec<u32>>, Vec<Vec<f32>>) = part
                 .panels
                 .into_iter()
@@ -414,11 +413,11 @@ impl StageRun for TransportKnobs {
         ws: &mut Workspace,
         txn: &mut BakeTransaction,
         shards: Vec<(PathBuf, Payload)>,
-        prepared: Option<(PathBuf, Payload)>,
+        prepared: Option<Mapped>,
     ) -> Result<StageRecord> {
         let albedo = albedos(ws.patches()?);
         let n = albedo.len();
-        let (ppath, mut prepared) = prepared.ok_or_else(|| {
+        let prepared = prepared.ok_or_else(|| {
             Error::verify(
                 "transport-prepared.0-of-1.shard",
                 "missing beside the transport's shards (the merge of the previous round writes it)",
@@ -426,7 +425,7 @@ impl StageRun for TransportKnobs {
         })?;
         let channels = transport_channels(&albedo);
         let solvers = (0..channels)
-            .map(|c| read_solver(&mut prepared, &ppath, c))
+            .map(|c| read_solver(&prepared, c))
             .collect::<Result<Vec<_>>>()?;
         drop(prepared);
         let f = ws.form_factors()?;
@@ -543,15 +542,15 @@ fn check_shape(f_n: usize, n: usize) -> Result<()> {
 }
 
 /// The solver and estimated error of channel `c` from the transport's prepared factors.
-fn read_solver(p: &mut Payload, path: &std::path::Path, c: usize) -> Result<(InfiniteSolver, f64)> {
-    let solver = match p.u32s(&format!("solver_{c}"), path)?.first() {
+fn read_solver(p: &Mapped, c: usize) -> Result<(InfiniteSolver, f64)> {
+    let solver = match p.u32s(&format!("solver_{c}"))?.first() {
         Some(0) => InfiniteSolver::Auto,
         Some(1) => InfiniteSolver::F32,
         Some(2) => InfiniteSolver::F64,
-        other => return Err(Error::verify(path, format!("unknown solver {other:?}"))),
+        other => return Err(Error::verify(p.path(), format!("unknown solver {other:?}"))),
     };
     let error = p
-        .f64s(&format!("error_{c}"), path)?
+        .f64s(&format!("error_{c}"))?
         .first()
         .copied()
         .unwrap_or(f64::NAN);
@@ -559,30 +558,23 @@ fn read_solver(p: &mut Payload, path: &std::path::Path, c: usize) -> Result<(Inf
 }
 
 /// Channel `c`'s factors from the transport's prepared factors.
-fn read_factors(
-    p: &mut Payload,
-    path: &std::path::Path,
-    c: usize,
-    n: usize,
-) -> Result<ChannelFactors> {
-    let (solver, error) = read_solver(p, path, c)?;
-    let perm = p.u64s(&format!("perm_{c}"), path)?;
+fn read_factors(p: &Mapped, c: usize, n: usize) -> Result<ChannelFactors> {
+    let (solver, error) = read_solver(p, c)?;
+    let perm = p.u64s(&format!("perm_{c}"))?;
     let bad = || {
         Error::verify(
-            path,
+            p.path(),
             format!("the factors of channel {c} are not {n} x {n}"),
         )
     };
     if perm.len() != n {
         return Err(bad());
     }
-    let factor = match solver {
-        InfiniteSolver::F64 => InfiniteFactor::F64(
-            Factored::from_parts(&p.f64s(&format!("lu_{c}"), path)?, &perm).ok_or_else(bad)?,
-        ),
-        _ => InfiniteFactor::F32(
-            Factored::from_parts(&p.f32s(&format!("lu_{c}"), path)?, &perm).ok_or_else(bad)?,
-        ),
+    let lu = format!("lu_{c}");
+    let factor = if p.has(&lu, "f64") {
+        InfiniteFactor::F64(Factored::from_parts(&p.f64s(&lu)?, &perm).ok_or_else(bad)?)
+    } else {
+        InfiniteFactor::F32(Factored::from_parts(&p.f32s(&lu)?, &perm).ok_or_else(bad)?)
     };
     Ok(ChannelFactors {
         factor,
