@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{bake, data, expect_code, gpu, list_files};
+use common::{bake, contents, data, expect_code, gpu};
 use std::path::Path;
 use std::process::Command;
 
@@ -14,17 +14,6 @@ const THREADS: [&str; 3] = ["1", "2", "8"];
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-/// Every file under `dir` (sorted relative paths) with its bytes.
-fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    list_files(dir)
-        .into_iter()
-        .map(|f| {
-            let bytes = std::fs::read(dir.join(&f)).unwrap();
-            (f, bytes)
-        })
-        .collect()
 }
 
 fn assert_same(dirs: &[std::path::PathBuf], what: &str) {

@@ -6,9 +6,8 @@
 
 mod common;
 
-use common::{bake, data, expect_code, list_files, python, require_python};
+use common::{bake, contents, data, expect_code, python, require_python};
 use serde_json::Value;
-use std::path::Path;
 use std::process::Command;
 
 fn load(name: &str) -> Value {
@@ -95,16 +94,6 @@ fn command(job: &Value) -> Vec<String> {
         .unwrap()
         .iter()
         .map(|v| v.as_str().unwrap().to_string())
-        .collect()
-}
-
-fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    list_files(dir)
-        .into_iter()
-        .map(|f| {
-            let b = std::fs::read(dir.join(&f)).unwrap();
-            (f, b)
-        })
         .collect()
 }
 

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bake, bake_killed_after, data, expect_code, list_files};
+use common::{bake, bake_killed_after, contents, data, expect_code, list_files};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -20,17 +20,6 @@ fn pipeline(dir: &Path, name: &str, encode: &str) -> PathBuf {
     )
     .unwrap();
     p
-}
-
-/// Every file of a baked directory with its bytes.
-fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    list_files(dir)
-        .into_iter()
-        .map(|n| {
-            let b = std::fs::read(dir.join(&n)).unwrap();
-            (n, b)
-        })
-        .collect()
 }
 
 /// `run --json`: the report's stages that came from the cache, and whether it was up to date.

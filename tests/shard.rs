@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{bake, bake_killed_after, data, expect_code, list_files};
+use common::{bake, bake_killed_after, contents, data, expect_code};
 use relume::progress::Silent;
 use relume::radiosity::formfactor::{
     assemble, form_factor_rows, form_factors, shard_rows, Estimator, FormFactorParams,
@@ -41,16 +41,6 @@ fn pipeline(
     )
     .unwrap();
     p
-}
-
-fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    list_files(dir)
-        .into_iter()
-        .map(|f| {
-            let b = std::fs::read(dir.join(&f)).unwrap();
-            (f, b)
-        })
-        .collect()
 }
 
 fn spawn(cwd: &Path, args: &[&str]) -> Child {

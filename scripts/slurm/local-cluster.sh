@@ -11,10 +11,19 @@ mkdir -p "$dir"
 dir=$(cd "$dir" && pwd)
 conf=$dir/slurm.conf
 if [ "$cmd" = stop ]; then
-    for p in slurmd slurmctld; do
-        [ -f "$dir/$p.pid" ] && kill "$(cat "$dir/$p.pid")" 2>/dev/null || true
+    pids=()
+    for p in slurmd slurmctld munged; do
+        [ -f "$dir/$p.pid" ] && pids+=("$(cat "$dir/$p.pid")")
     done
-    [ -f "$dir/munged.pid" ] && kill "$(cat "$dir/munged.pid")" 2>/dev/null || true
+    [ ${#pids[@]} -gt 0 ] && kill "${pids[@]}" 2>/dev/null || true
+    # Wait for them to exit, so that the ports are free for the next cluster.
+    for _ in $(seq 1 50); do
+        alive=0
+        for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+        [ $alive = 0 ] && exit 0
+        sleep 0.1
+    done
+    kill -9 "${pids[@]}" 2>/dev/null || true
     exit 0
 fi
 host=$(hostname -s)
@@ -70,5 +79,5 @@ for _ in $(seq 1 60); do
     sleep 1
 done
 echo "slurm did not come up (node state: ${state:-none}); logs in $dir" >&2
-tail -20 "$dir/slurmctld.log" "$dir/slurmd.log" >&2 || true
+tail -n 20 "$dir/slurmctld.log" "$dir/slurmd.log" >&2 || true
 exit 1

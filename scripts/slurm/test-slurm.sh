@@ -17,7 +17,10 @@ done
 work=$(mktemp -d /tmp/relume-slurm.XXXXXX)
 cluster=$work/cluster
 export SLURMCTLD_PORT=${SLURMCTLD_PORT:-16817} SLURMD_PORT=${SLURMD_PORT:-16818}
-cleanup() { $sudo "$repo/scripts/slurm/local-cluster.sh" stop "$cluster" || true; }
+cleanup() {
+    $sudo "$repo/scripts/slurm/local-cluster.sh" stop "$cluster" || true
+    rm -rf "$work"
+}
 trap cleanup EXIT
 $sudo env SLURMCTLD_PORT="$SLURMCTLD_PORT" SLURMD_PORT="$SLURMD_PORT" \
     "$repo/scripts/slurm/local-cluster.sh" start "$cluster" "$n"
@@ -93,4 +96,3 @@ echo "slurm with $task killed and requeued (Restarts=$restarts): $(awk "BEGIN {p
 same "$work/requeued" "slurm, killed and requeued"
 cmp "$work/array.shards/form_factors.1-of-$n.shard" "$work/requeued.shards/form_factors.1-of-$n.shard"
 echo "the requeued task's shard is byte-identical to the clean run's"
-rm -rf "$work"

@@ -83,6 +83,18 @@ pub fn python(code: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
+/// Every file under `dir` (sorted relative names) with its bytes: two bakes are byte-identical
+/// when these are equal.
+pub fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    list_files(dir)
+        .into_iter()
+        .map(|f| {
+            let bytes = std::fs::read(dir.join(&f)).unwrap();
+            (f, bytes)
+        })
+        .collect()
+}
+
 /// All files (recursively) under `dir`, relative names, sorted.
 pub fn list_files(dir: &Path) -> Vec<String> {
     let mut out = Vec::new();
