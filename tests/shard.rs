@@ -232,8 +232,37 @@ fn missing_duplicated_truncated_damaged_and_foreign_shards_are_refused_by_name()
     let d = t.join("empty");
     std::fs::create_dir(&d).unwrap();
     refused(t, &out, &d, &["no shard files"]);
-    // The good set merges.
+    // The good set merges; that merge prepares the transport's factors for round 2.
     expect_code(&bake(t, &["-q", "merge", s(&out), s(&good)]), 0);
+    let prepared = good.join("transport-prepared.0-of-1.shard");
+    assert!(prepared.is_file());
+    let round2 = [
+        "-q",
+        "run",
+        s(&p),
+        "--out",
+        s(&out),
+        "--shard",
+        "0/3",
+        "--shard-dir",
+        s(&good),
+    ];
+    // Damaged factors, then none at all: refused by name.
+    let bytes = std::fs::read(&prepared).unwrap();
+    let mut bad = bytes.clone();
+    let last = bad.len() - 1;
+    bad[last] ^= 1;
+    std::fs::write(&prepared, &bad).unwrap();
+    let err = expect_code(&bake(t, &round2), 7);
+    assert!(
+        err.contains("transport-prepared.0-of-1.shard") && err.contains("SHA-256"),
+        "{err}"
+    );
+    std::fs::remove_file(&prepared).unwrap();
+    let err = expect_code(&bake(t, &round2), 7);
+    assert!(err.contains("transport-prepared.0-of-1.shard"), "{err}");
+    std::fs::write(&prepared, &bytes).unwrap();
+    expect_code(&bake(t, &round2), 0);
 }
 
 #[test]

@@ -208,7 +208,7 @@ pub fn run_pipeline(
                     }
                     (Sharding::Merge { .. }, true) => {
                         let set = merge_set.as_ref().expect("scanned for a merge");
-                        let Some(shards) = set.payloads(name, &key)? else {
+                        let Some(shards) = set.complete(name, &key)? else {
                             // The next round: what its shards share is made here, once.
                             if let Some(p) = run.prepare_shards(&mut ws)? {
                                 let Sharding::Merge { dirs } = &opts.sharding else {

@@ -254,20 +254,6 @@ impl ShardSet {
         &self.headers[0].1.pipeline
     }
 
-    /// The arrays of the complete set of shards of `stage` (see [`ShardSet::complete`]), each
-    /// verified whole, in index order; `None` when there is no shard of `stage` at all.
-    pub fn payloads(&self, stage: &str, key: &str) -> Result<Option<Vec<(PathBuf, Payload)>>> {
-        let Some(paths) = self.complete(stage, key)? else {
-            return Ok(None);
-        };
-        let mut out = Vec::with_capacity(paths.len());
-        for p in paths {
-            let (_, payload) = shard::read(&p)?;
-            out.push((p, payload));
-        }
-        Ok(Some(out))
-    }
-
     /// The complete, consistent set of shards of `stage` with cache key `key`, in index order;
     /// `None` when there is no shard of `stage` at all.
     pub fn complete(&self, stage: &str, key: &str) -> Result<Option<Vec<PathBuf>>> {

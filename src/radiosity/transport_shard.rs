@@ -116,31 +116,58 @@ pub fn assemble_infinite(
     factors: &[(InfiniteSolver, f64)],
     parts: Vec<Vec<ChannelPart>>,
 ) -> Result<Transport> {
-    let n = albedo.len();
-    let channels = channels(albedo);
-    if factors.len() != channels {
-        return Err(Error::Internal(format!(
-            "{} channel factors for {channels} channels",
-            factors.len()
-        )));
-    }
-    let mut values = vec![0f32; channels * n * n];
-    let mut out = Transport {
-        matrix: TransportMatrix::zeros(channels, 0),
-        bounces: vec![0; channels],
-        products: 0,
-        spectral_bounds: Vec::new(),
-        solvers: factors.to_vec(),
-    };
     let count = parts.len();
-    for c in 0..channels {
-        let rho = rho(albedo, c);
-        out.spectral_bounds
-            .push(infinite_bounds(RowMajor { f, rho: &rho })?);
-        for (i, part) in parts.iter().enumerate() {
-            let ch = part
-                .get(c)
-                .ok_or_else(|| Error::Internal(format!("transport part {i} has no channel {c}")))?;
+    let mut a = Assembly::new(albedo, factors, count)?;
+    for (i, part) in parts.into_iter().enumerate() {
+        a.add(i, part)?;
+    }
+    a.finish(f, albedo)
+}
+
+/// [`assemble_infinite`] one part at a time, so that only one part's columns are held besides S.
+pub struct Assembly {
+    n: usize,
+    channels: usize,
+    count: usize,
+    added: Vec<bool>,
+    solvers: Vec<(InfiniteSolver, f64)>,
+    values: Vec<f32>,
+}
+
+impl Assembly {
+    pub fn new(
+        albedo: &[[f32; 3]],
+        factors: &[(InfiniteSolver, f64)],
+        count: usize,
+    ) -> Result<Self> {
+        let n = albedo.len();
+        let channels = channels(albedo);
+        if factors.len() != channels {
+            return Err(Error::Internal(format!(
+                "{} channel factors for {channels} channels",
+                factors.len()
+            )));
+        }
+        Ok(Assembly {
+            n,
+            channels,
+            count,
+            added: vec![false; count],
+            solvers: factors.to_vec(),
+            values: vec![0f32; channels * n * n],
+        })
+    }
+
+    /// Part `i` (every channel's panels).
+    pub fn add(&mut self, i: usize, part: Vec<ChannelPart>) -> Result<()> {
+        let (n, count) = (self.n, self.count);
+        if i >= count || self.added[i] || part.len() != self.channels {
+            return Err(Error::Internal(format!(
+                "transport part {i} of {count}: added twice, out of range or with {} channels",
+                part.len()
+            )));
+        }
+        for (c, ch) in part.iter().enumerate() {
             let want = part_panels(n, i, count).len();
             if ch.panels.len() != want {
                 return Err(Error::Internal(format!(
@@ -148,9 +175,31 @@ pub fn assemble_infinite(
                     ch.panels.len()
                 )));
             }
-            scatter(&ch.panels, n, &mut values[c * n * n..(c + 1) * n * n]);
+            scatter(&ch.panels, n, &mut self.values[c * n * n..(c + 1) * n * n]);
         }
+        self.added[i] = true;
+        Ok(())
     }
-    out.matrix = TransportMatrix::new(channels, n, values)?;
-    Ok(out)
+
+    /// The transport, once every part is in.
+    pub fn finish(self, f: &[f32], albedo: &[[f32; 3]]) -> Result<Transport> {
+        if let Some(i) = self.added.iter().position(|a| !a) {
+            return Err(Error::Internal(format!(
+                "transport part {i} of {} missing",
+                self.count
+            )));
+        }
+        let mut bounds = Vec::with_capacity(self.channels);
+        for c in 0..self.channels {
+            let rho = rho(albedo, c);
+            bounds.push(infinite_bounds(RowMajor { f, rho: &rho })?);
+        }
+        Ok(Transport {
+            matrix: TransportMatrix::new(self.channels, self.n, self.values)?,
+            bounces: vec![0; self.channels],
+            products: 0,
+            spectral_bounds: bounds,
+            solvers: self.solvers,
+        })
+    }
 }

@@ -55,13 +55,14 @@ pub trait StageRun {
         ))
     }
 
-    /// Put every shard's arrays (in index order) together, write the stage's files into `txn`
-    /// as [`StageRun::run`] would, and return the same record.
+    /// Put every shard (the files of a complete set, in index order, each read and verified
+    /// one at a time with `crate::baked::shard::read`) together, write the stage's files into
+    /// `txn` as [`StageRun::run`] would, and return the same record.
     fn merge_shards(
         &self,
         _ws: &mut Workspace,
         _txn: &mut BakeTransaction,
-        _shards: Vec<(PathBuf, Payload)>,
+        _shards: Vec<PathBuf>,
         _prepared: Option<Mapped>,
     ) -> Result<StageRecord> {
         Err(crate::error::Error::Internal(

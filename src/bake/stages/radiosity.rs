@@ -18,8 +18,8 @@ use crate::radiosity::transport::{
     memory_estimate, transport, Bounces, Transport, TransportParams,
 };
 use crate::radiosity::transport_shard::{
-    assemble_infinite, channels as transport_channels, factor_channels, part_memory, part_panels,
-    solve_part, ChannelFactors, ChannelPart,
+    channels as transport_channels, factor_channels, part_memory, part_panels, solve_part,
+    Assembly, ChannelFactors, ChannelPart,
 };
 use crate::radiosity::voxelize::{voxelize_noting, Resolution};
 use std::path::PathBuf;
@@ -166,7 +166,7 @@ impl StageRun for FormFactorsKnobs {
         &self,
         ws: &mut Workspace,
         txn: &mut BakeTransaction,
-        shards: Vec<(PathBuf, Payload)>,
+        shards: Vec<PathBuf>,
         _prepared: Option<Mapped>,
     ) -> Result<StageRecord> {
         let budget = ws.memory_budget();
@@ -174,8 +174,10 @@ impl StageRun for FormFactorsKnobs {
         let n = set.len();
         check_form_factor_memory(n, budget)?;
         let count = shards.len();
-        let mut blocks = Vec::with_capacity(count);
-        for (i, (path, mut p)) in shards.into_iter().enumerate() {
+        // One block of all rows, filled shard by shard (one shard's arrays held at a time).
+        let (mut values, mut upper, mut unassigned) = (Vec::new(), Vec::new(), 0);
+        for (i, path) in shards.into_iter().enumerate() {
+            let (_, mut p) = crate::baked::shard::read(&path)?;
             let want = shard_rows(self.estimator, n, i, count);
             let rows = p.u64s("rows", &path)?;
             if rows != [want.start as u64, want.end as u64] {
@@ -184,22 +186,36 @@ impl StageRun for FormFactorsKnobs {
                     format!("holds rows {rows:?}, shard {i} of {count} should hold {want:?}"),
                 ));
             }
-            let block = if self.estimator == Estimator::Pairwise {
-                RowBlock::Pairwise {
-                    rows: want,
-                    upper: p.f64s("upper", &path)?,
-                }
+            let len_ok = if self.estimator == Estimator::Pairwise {
+                let u = p.f64s("upper", &path)?;
+                let ok = u.len() == want.clone().map(|r| n - r).sum::<usize>();
+                upper.extend(u);
+                ok
             } else {
-                RowBlock::Hemisphere {
-                    rows: want,
-                    values: p.f32s("values", &path)?,
-                    unassigned: p.u64s("unassigned", &path)?.first().copied().unwrap_or(0),
-                }
+                let v = p.f32s("values", &path)?;
+                let ok = v.len() == want.len() * n;
+                values.extend(v);
+                unassigned += p.u64s("unassigned", &path)?.first().copied().unwrap_or(0);
+                ok
             };
-            blocks.push(block);
+            if !len_ok {
+                return Err(Error::verify(
+                    &path,
+                    "its rows do not have the patches' length",
+                ));
+            }
         }
-        let f = assemble(set, &self.params(), &blocks)?;
-        drop(blocks);
+        let block = if self.estimator == Estimator::Pairwise {
+            RowBlock::Pairwise { rows: 0..n, upper }
+        } else {
+            RowBlock::Hemisphere {
+                rows: 0..n,
+                values,
+                unassigned,
+            }
+        };
+        let f = assemble(set, &self.params(), std::slice::from_ref(&block))?;
+        drop(block);
         self.finish(ws, txn, f)
     }
 
@@ -412,7 +428,7 @@ impl StageRun for TransportKnobs {
         &self,
         ws: &mut Workspace,
         txn: &mut BakeTransaction,
-        shards: Vec<(PathBuf, Payload)>,
+        shards: Vec<PathBuf>,
         prepared: Option<Mapped>,
     ) -> Result<StageRecord> {
         let albedo = albedos(ws.patches()?);
@@ -428,10 +444,10 @@ impl StageRun for TransportKnobs {
             .map(|c| read_solver(&prepared, c))
             .collect::<Result<Vec<_>>>()?;
         drop(prepared);
-        let f = ws.form_factors()?;
-        check_shape(f.n, n)?;
-        let mut parts = Vec::with_capacity(shards.len());
-        for (path, mut p) in shards {
+        let count = shards.len();
+        let mut assembly = Assembly::new(&albedo, &solvers, count)?;
+        for (i, path) in shards.into_iter().enumerate() {
+            let (_, mut p) = crate::baked::shard::read(&path)?;
             let mut part = Vec::with_capacity(channels);
             for c in 0..channels {
                 let widths = p.u64s(&format!("panel_widths_{c}"), &path)?;
@@ -456,9 +472,11 @@ impl StageRun for TransportKnobs {
                 }
                 part.push(ChannelPart { panels });
             }
-            parts.push(part);
+            assembly.add(i, part).map_err(|e| Error::verify(&path, e))?;
         }
-        let t = assemble_infinite(&f.values, &albedo, &solvers, parts)?;
+        let f = ws.form_factors()?;
+        check_shape(f.n, n)?;
+        let t = assembly.finish(&f.values, &albedo)?;
         self.finish(ws, txn, n, t)
     }
 
