@@ -309,7 +309,13 @@ fn partial_report(
     BakeReport {
         output: output.to_path_buf(),
         up_to_date: false,
-        peak_rss_bytes: stages.iter().filter_map(|t| t.peak_rss_bytes).max(),
+        // The stage that stopped (a shard, a merge's preparation) has no timing of its own: the
+        // peak since its start counts too.
+        peak_rss_bytes: stages
+            .iter()
+            .filter_map(|t| t.peak_rss_bytes)
+            .chain(limits::peak_rss())
+            .max(),
         stages,
         files: Vec::new(),
         warnings,

@@ -266,8 +266,12 @@ pub fn plan_shards(
             .max()
             .unwrap_or(0);
         // The merge holds what earlier stages keep, the assembled output and its working copy
-        // (the reciprocity average copies F) or the shard being read.
-        merge_peak = merge_peak.max(resident + 2 * planned.output_bytes + base);
+        // (the reciprocity average copies F) or the shard being read; the merge before this
+        // round prepares what its shards share (the transport's factors).
+        let prepare = runner(stage).estimate_prepare(&state);
+        merge_peak = merge_peak
+            .max(resident + 2 * planned.output_bytes + base)
+            .max(resident + prepare + base);
         rounds.push(ShardRound {
             stage: stage.kind().name().into(),
             count,

@@ -23,6 +23,7 @@ use super::transaction::left_by_dead_process;
 use crate::error::{Error, IoContext, Result};
 use crate::pipeline::Pipeline;
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -63,6 +64,9 @@ pub struct ShardHeader {
     pub payload_sha256: String,
 }
 
+/// Writes a section's little-endian bytes, piece by piece, into a sink.
+type Emit<'a> = Box<dyn Fn(&mut dyn FnMut(&[u8])) + 'a>;
+
 /// The arrays of a shard, by section name.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Payload {
@@ -90,50 +94,40 @@ impl Payload {
         Self::take(&mut self.u64s, name, path)
     }
 
-    fn sections_and_bytes(&self) -> (Vec<Section>, Vec<u8>) {
-        let mut sections = Vec::new();
-        let mut bytes = Vec::new();
-        let mut put = |name: &str, dtype: &str, len: usize, data: Vec<u8>| {
-            sections.push(Section {
-                name: name.into(),
-                dtype: dtype.into(),
-                len: len as u64,
-            });
-            bytes.extend(data);
-        };
-        for (k, v) in &self.f32s {
-            put(
-                k,
-                "f32",
-                v.len(),
-                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            );
+    /// The sections in file order, each with a writer of its little-endian bytes (in pieces,
+    /// so that no copy of a large array is made).
+    fn sections(&self) -> Vec<(Section, Emit<'_>)> {
+        fn put<'a, T: Copy, const W: usize>(
+            out: &mut Vec<(Section, Emit<'a>)>,
+            map: &'a BTreeMap<String, Vec<T>>,
+            dtype: &str,
+            le: fn(T) -> [u8; W],
+        ) {
+            for (k, v) in map {
+                let section = Section {
+                    name: k.clone(),
+                    dtype: dtype.into(),
+                    len: v.len() as u64,
+                };
+                let emit = move |sink: &mut dyn FnMut(&[u8])| {
+                    let mut buf = Vec::with_capacity(1 << 16);
+                    for chunk in v.chunks(1 << 14) {
+                        buf.clear();
+                        for &x in chunk {
+                            buf.extend_from_slice(&le(x));
+                        }
+                        sink(&buf);
+                    }
+                };
+                out.push((section, Box::new(emit)));
+            }
         }
-        for (k, v) in &self.f64s {
-            put(
-                k,
-                "f64",
-                v.len(),
-                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            );
-        }
-        for (k, v) in &self.u32s {
-            put(
-                k,
-                "u32",
-                v.len(),
-                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            );
-        }
-        for (k, v) in &self.u64s {
-            put(
-                k,
-                "u64",
-                v.len(),
-                v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            );
-        }
-        (sections, bytes)
+        let mut out = Vec::new();
+        put(&mut out, &self.f32s, "f32", f32::to_le_bytes);
+        put(&mut out, &self.f64s, "f64", f64::to_le_bytes);
+        put(&mut out, &self.u32s, "u32", u32::to_le_bytes);
+        put(&mut out, &self.u64s, "u64", u64::to_le_bytes);
+        out
     }
 }
 
@@ -147,10 +141,19 @@ pub fn file_name(stage: &str, index: u32, count: u32) -> String {
 pub fn write(dir: &Path, mut header: ShardHeader, payload: &Payload) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).at(dir, "cannot create the shard directory")?;
     clean_stale(dir);
-    let (sections, bytes) = payload.sections_and_bytes();
-    header.sections = sections;
-    header.payload_bytes = bytes.len() as u64;
-    header.payload_sha256 = sha256_hex(&bytes);
+    // Two passes over the arrays: the hash for the header, then the bytes into the file.
+    let sections = payload.sections();
+    let mut hasher = Sha256::new();
+    let mut total = 0u64;
+    for (_, emit) in &sections {
+        emit(&mut |b: &[u8]| {
+            hasher.update(b);
+            total += b.len() as u64;
+        });
+    }
+    header.sections = sections.iter().map(|(s, _)| s.clone()).collect();
+    header.payload_bytes = total;
+    header.payload_sha256 = sections_hex(&hasher.finalize());
     let json = serde_json::to_vec(&header).map_err(|e| Error::Internal(e.to_string()))?;
     let name = file_name(&header.stage, header.index, header.count);
     let path = dir.join(&name);
@@ -160,7 +163,19 @@ pub fn write(dir: &Path, mut header: ShardHeader, payload: &Payload) -> Result<P
         f.write_all(MAGIC)?;
         f.write_all(&(json.len() as u64).to_le_bytes())?;
         f.write_all(&json)?;
-        f.write_all(&bytes)?;
+        let mut failed = None;
+        for (_, emit) in &sections {
+            emit(&mut |b: &[u8]| {
+                if failed.is_none() {
+                    if let Err(e) = f.write_all(b) {
+                        failed = Some(e);
+                    }
+                }
+            });
+        }
+        if let Some(e) = failed {
+            return Err(e);
+        }
         f.into_inner().map_err(|e| e.into_error())?.sync_all()
     })();
     if let Err(e) = result {
@@ -396,4 +411,8 @@ impl Mapped {
     pub fn path(&self) -> &Path {
         &self.path
     }
+}
+
+fn sections_hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }

@@ -70,6 +70,12 @@ pub trait StageRun {
         ))
     }
 
+    /// Estimated working bytes of [`StageRun::prepare_shards`] (after `estimate` updated
+    /// `state`), besides what earlier stages keep.
+    fn estimate_prepare(&self, _state: &PlanState) -> u64 {
+        0
+    }
+
     /// Estimated peak bytes of shard `index` of `count` (after `estimate` updated `state`).
     fn estimate_shard(&self, _state: &PlanState, _index: usize, _count: usize) -> u64 {
         0

@@ -480,6 +480,12 @@ impl StageRun for TransportKnobs {
         self.finish(ws, txn, n, t)
     }
 
+    fn estimate_prepare(&self, state: &PlanState) -> u64 {
+        // The factors of every channel (f32), held until they are written.
+        let n2 = state.patches * state.patches;
+        state.channels.max(1) * n2 * 4 + n2 * 2
+    }
+
     fn estimate_shard(&self, state: &PlanState, index: usize, count: usize) -> u64 {
         let n = state.patches as usize;
         part_memory(n, state.channels.max(1) as usize, index, count)
