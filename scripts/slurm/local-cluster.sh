@@ -38,7 +38,7 @@ fi
 socket=$dir/munge/munge.socket
 cat > "$conf" <<CONF
 ClusterName=relume
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
@@ -62,7 +62,7 @@ SlurmdParameters=config_overrides
 ReturnToService=2
 JobRequeue=1
 MpiDefault=none
-NodeName=$host CPUs=$cpus RealMemory=$mem State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=relume Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
 munged --force --socket="$socket" --key-file="$dir/munge/munge.key" \
