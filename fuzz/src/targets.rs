@@ -152,8 +152,8 @@ fn freeform(path: &Path, text: &str) {
     }
 }
 
-/// The player's readers of a baked directory: patches, scene, transfer info, sidecar, the
-/// `.npy` matrices (and the horizon maps' u16 / i32 arrays), the permutation, the mipmap EXR, and the DDS / KTX2 texture parsers for
+/// The player's readers of a baked directory: patches, scene, transfer info, sidecar, shard
+/// files, the `.npy` matrices (and the horizon maps' u16 / i32 arrays), the permutation, the mipmap EXR, and the DDS / KTX2 texture parsers for
 /// every encoding.
 pub fn baked(data: &[u8]) {
     use relume::baked;
@@ -191,10 +191,24 @@ pub fn baked(data: &[u8]) {
             drop(baked::npy::parse_npy::<u16>(rest));
             drop(baked::npy::parse_npy::<i32>(rest));
         }
-        5 => drop(baked::form_factors::read_file(&file(
-            baked::form_factors::FILE,
-            rest,
-        ))),
+        5 => {
+            drop(baked::form_factors::read_file(&file(
+                baked::form_factors::FILE,
+                rest,
+            )));
+            // Shard files (form factors, transport panels, prepared factors): whole and mapped.
+            let p = file("part.0-of-1.shard", rest);
+            drop(baked::shard::read(&p));
+            if let Ok(m) = baked::shard::Mapped::open(&p) {
+                let names: Vec<_> = m.header.sections.iter().map(|s| s.name.clone()).collect();
+                for n in names {
+                    drop(m.f32s(&n));
+                    drop(m.f64s(&n));
+                    drop(m.u32s(&n));
+                    drop(m.u64s(&n));
+                }
+            }
+        }
         6 => drop(baked::permutation::read_file(&file(
             baked::permutation::FILE,
             rest,

@@ -237,8 +237,9 @@ pub fn read_header(path: &Path) -> Result<ShardHeader> {
         .map_err(|_| Error::verify(path, "truncated: the header ends past the file"))?;
     let header: ShardHeader = serde_json::from_slice(&json)
         .map_err(|e| Error::verify(path, format!("the shard's header is malformed: {e}")))?;
-    let want = 24 + len + header.payload_bytes;
-    if size != want {
+    let want = (24 + len).checked_add(header.payload_bytes);
+    if want != Some(size) {
+        let want = want.map_or("more than 2^64".into(), |w| w.to_string());
         return Err(Error::verify(
             path,
             format!(
@@ -274,10 +275,9 @@ pub fn read(path: &Path) -> Result<(ShardHeader, Payload)> {
                 ))
             }
         };
-        let end = at + s.len as usize * width;
-        let raw = data
-            .get(at..end)
+        let end = section_end(at, s.len, width, data.len())
             .ok_or_else(|| Error::verify(path, "the sections run past the payload"))?;
+        let raw = &data[at..end];
         let name = s.name.clone();
         match s.dtype.as_str() {
             "f32" => {
@@ -355,7 +355,8 @@ impl Mapped {
             } else {
                 4
             };
-            let end = at + s.len as usize * width;
+            let end = section_end(at, s.len, width, self.map.len())
+                .ok_or_else(|| Error::verify(&self.path, "the sections run past the payload"))?;
             if s.name == name {
                 if s.dtype != dtype {
                     return Err(Error::verify(
@@ -363,10 +364,7 @@ impl Mapped {
                         format!("section `{name}` is {}, not {dtype}", s.dtype),
                     ));
                 }
-                return self
-                    .map
-                    .get(at..end)
-                    .ok_or_else(|| Error::verify(&self.path, "the sections run past the payload"));
+                return Ok(&self.map[at..end]);
             }
             at = end;
         }
@@ -415,4 +413,14 @@ impl Mapped {
 
 fn sections_hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Where a section of `len` elements of `width` bytes starting at `at` ends, if within `limit`
+/// (a header may claim any length: no overflow, no slice past the end).
+fn section_end(at: usize, len: u64, width: usize, limit: usize) -> Option<usize> {
+    usize::try_from(len)
+        .ok()
+        .and_then(|l| l.checked_mul(width))
+        .and_then(|b| b.checked_add(at))
+        .filter(|&e| e <= limit)
 }
