@@ -523,7 +523,6 @@ mod mutated_shard_files {
             facts: Default::default(),
             sections: Vec::new(),
             payload_bytes: 0,
-            payload_sha256: String::new(),
         };
         (shard::write(dir, header, &p).unwrap(), p)
     }

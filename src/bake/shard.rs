@@ -108,7 +108,6 @@ impl ShardAt<'_> {
             facts: Default::default(),
             sections: Vec::new(),
             payload_bytes: 0,
-            payload_sha256: String::new(),
         };
         let path = shard::write(self.dir, header, &payload)?;
         Ok(written(part, path, false))
@@ -159,7 +158,6 @@ pub fn write_prepared(
         facts: Default::default(),
         sections: Vec::new(),
         payload_bytes: 0,
-        payload_sha256: String::new(),
     };
     shard::write(dir, header, payload)
 }
@@ -234,6 +232,8 @@ impl ShardSet {
                 ),
             ));
         }
+        // The pipeline comes from the first shard's header: check that file whole first.
+        shard::read(&headers[0].0)?;
         Ok(ShardSet { headers })
     }
 

@@ -8,17 +8,18 @@
 //! header length                 u64 little-endian
 //! header                        JSON (ShardHeader)
 //! payload                       the sections, each little-endian, back to back
+//! SHA-256                       32 bytes: of everything before it
 //! ```
 //!
 //! The header names the bake (`bake`: the hash of the pipeline and the input file), the stage,
 //! the shard's index and count, the stage's cache key (relume's version and source, the baked
 //! format, the stage's knobs and the hashes of every file the stage reads: see `bake::cache`),
-//! and the payload's sections, size and SHA-256. It is written to `.NAME.tmp-PID` in the same
+//! and the payload's sections and size; the file ends with the SHA-256 of all that comes before,
+//! so a changed header is caught as surely as a changed payload. It is written to `.NAME.tmp-PID` in the same
 //! directory and renamed into place, so a killed shard leaves either nothing or a whole file;
 //! the next shard written into that directory on the same host removes temporaries of processes
 //! that no longer run.
 
-use super::manifest::sha256_hex;
 use super::transaction::left_by_dead_process;
 use crate::error::{Error, IoContext, Result};
 use crate::pipeline::Pipeline;
@@ -61,7 +62,6 @@ pub struct ShardHeader {
     pub facts: BTreeMap<String, String>,
     pub sections: Vec<Section>,
     pub payload_bytes: u64,
-    pub payload_sha256: String,
 }
 
 /// Writes a section's little-endian bytes, piece by piece, into a sink.
@@ -141,33 +141,39 @@ pub fn file_name(stage: &str, index: u32, count: u32) -> String {
 pub fn write(dir: &Path, mut header: ShardHeader, payload: &Payload) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).at(dir, "cannot create the shard directory")?;
     clean_stale(dir);
-    // Two passes over the arrays: the hash for the header, then the bytes into the file.
     let sections = payload.sections();
-    let mut hasher = Sha256::new();
-    let mut total = 0u64;
-    for (_, emit) in &sections {
-        emit(&mut |b: &[u8]| {
-            hasher.update(b);
-            total += b.len() as u64;
-        });
-    }
     header.sections = sections.iter().map(|(s, _)| s.clone()).collect();
-    header.payload_bytes = total;
-    header.payload_sha256 = sections_hex(&hasher.finalize());
+    header.payload_bytes = header
+        .sections
+        .iter()
+        .map(|s| {
+            s.len
+                * if s.dtype == "f64" || s.dtype == "u64" {
+                    8
+                } else {
+                    4
+                }
+        })
+        .sum();
     let json = serde_json::to_vec(&header).map_err(|e| Error::Internal(e.to_string()))?;
     let name = file_name(&header.stage, header.index, header.count);
     let path = dir.join(&name);
     let tmp = dir.join(format!(".{name}.tmp-{}-{}", host(), std::process::id()));
     let result = (|| -> std::io::Result<()> {
         let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        f.write_all(MAGIC)?;
-        f.write_all(&(json.len() as u64).to_le_bytes())?;
-        f.write_all(&json)?;
+        let mut hasher = Sha256::new();
+        let mut put = |f: &mut std::io::BufWriter<std::fs::File>, b: &[u8]| {
+            hasher.update(b);
+            f.write_all(b)
+        };
+        put(&mut f, MAGIC)?;
+        put(&mut f, &(json.len() as u64).to_le_bytes())?;
+        put(&mut f, &json)?;
         let mut failed = None;
         for (_, emit) in &sections {
             emit(&mut |b: &[u8]| {
                 if failed.is_none() {
-                    if let Err(e) = f.write_all(b) {
+                    if let Err(e) = put(&mut f, b) {
                         failed = Some(e);
                     }
                 }
@@ -176,6 +182,7 @@ pub fn write(dir: &Path, mut header: ShardHeader, payload: &Payload) -> Result<P
         if let Some(e) = failed {
             return Err(e);
         }
+        f.write_all(&hasher.finalize())?;
         f.into_inner().map_err(|e| e.into_error())?.sync_all()
     })();
     if let Err(e) = result {
@@ -237,7 +244,7 @@ pub fn read_header(path: &Path) -> Result<ShardHeader> {
         .map_err(|_| Error::verify(path, "truncated: the header ends past the file"))?;
     let header: ShardHeader = serde_json::from_slice(&json)
         .map_err(|e| Error::verify(path, format!("the shard's header is malformed: {e}")))?;
-    let want = (24 + len).checked_add(header.payload_bytes);
+    let want = (24 + len + TRAILER).checked_add(header.payload_bytes);
     if want != Some(size) {
         let want = want.map_or("more than 2^64".into(), |w| w.to_string());
         return Err(Error::verify(
@@ -250,18 +257,12 @@ pub fn read_header(path: &Path) -> Result<ShardHeader> {
     Ok(header)
 }
 
-/// Read a shard whole: header and payload, the payload's SHA-256 checked.
+/// Read a shard whole: header and payload, the file's SHA-256 checked.
 pub fn read(path: &Path) -> Result<(ShardHeader, Payload)> {
     let header = read_header(path)?;
     let bytes = std::fs::read(path).at(path, "cannot read the shard")?;
-    let start = bytes.len() - header.payload_bytes as usize;
-    let data = &bytes[start..];
-    if sha256_hex(data) != header.payload_sha256 {
-        return Err(Error::verify(
-            path,
-            "damaged: the payload does not match its SHA-256",
-        ));
-    }
+    let body = checked_body(&bytes, path)?;
+    let data = &body[body.len() - header.payload_bytes as usize..];
     let mut payload = Payload::default();
     let mut at = 0usize;
     for s in &header.sections {
@@ -332,13 +333,8 @@ impl Mapped {
         let file = std::fs::File::open(path).at(path, "cannot read the shard")?;
         // SAFETY: shard files are written once and renamed into place, never changed in place.
         let map = unsafe { memmap2::Mmap::map(&file) }.at(path, "cannot map the shard")?;
-        let start = map.len() - header.payload_bytes as usize;
-        if sha256_hex(&map[start..]) != header.payload_sha256 {
-            return Err(Error::verify(
-                path,
-                "damaged: the payload does not match its SHA-256",
-            ));
-        }
+        let body_len = checked_body(&map, path)?.len();
+        let start = body_len - header.payload_bytes as usize;
         Ok(Mapped {
             map,
             start,
@@ -355,7 +351,7 @@ impl Mapped {
             } else {
                 4
             };
-            let end = section_end(at, s.len, width, self.map.len())
+            let end = section_end(at, s.len, width, self.map.len() - TRAILER as usize)
                 .ok_or_else(|| Error::verify(&self.path, "the sections run past the payload"))?;
             if s.name == name {
                 if s.dtype != dtype {
@@ -411,10 +407,6 @@ impl Mapped {
     }
 }
 
-fn sections_hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
 /// Where a section of `len` elements of `width` bytes starting at `at` ends, if within `limit`
 /// (a header may claim any length: no overflow, no slice past the end).
 fn section_end(at: usize, len: u64, width: usize, limit: usize) -> Option<usize> {
@@ -423,4 +415,25 @@ fn section_end(at: usize, len: u64, width: usize, limit: usize) -> Option<usize>
         .and_then(|l| l.checked_mul(width))
         .and_then(|b| b.checked_add(at))
         .filter(|&e| e <= limit)
+}
+
+/// Bytes of the SHA-256 that ends every shard file (of everything before it: magic, header,
+/// payload).
+const TRAILER: u64 = 32;
+
+/// The file without its trailer, once the trailer is the SHA-256 of the rest (every header field
+/// and every payload byte is covered).
+fn checked_body<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a [u8]> {
+    let cut = bytes
+        .len()
+        .checked_sub(TRAILER as usize)
+        .ok_or_else(|| Error::verify(path, "truncated: shorter than its checksum"))?;
+    let (body, sum) = bytes.split_at(cut);
+    if Sha256::digest(body).as_slice() != sum {
+        return Err(Error::verify(
+            path,
+            "damaged: the file does not match its SHA-256",
+        ));
+    }
+    Ok(body)
 }
