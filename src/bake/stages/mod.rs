@@ -5,6 +5,7 @@
 mod compress;
 mod radiosity;
 mod terrain;
+mod transport;
 
 use super::estimate::{PlanState, PlannedStage};
 use super::workspace::Workspace;
