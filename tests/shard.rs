@@ -511,19 +511,14 @@ mod mutated_shard_files {
         p.u64s.insert("rows".into(), vec![0, 3]);
         p.f64s.insert("upper".into(), vec![1.5; 40]);
         p.u32s.insert("columns".into(), (0..17).collect());
-        let header = ShardHeader {
-            bake: "b".into(),
-            stage: "form_factors".into(),
-            index: 0,
-            count: 1,
-            key: "k".repeat(64),
-            relume_version: "0".into(),
-            pipeline,
-            part: "rows 0..3 of 100".into(),
-            facts: Default::default(),
-            sections: Vec::new(),
-            payload_bytes: 0,
-        };
+        let header = ShardHeader::new(
+            "b".into(),
+            "form_factors".into(),
+            (0, 1),
+            &"k".repeat(64),
+            &pipeline,
+            "rows 0..3 of 100".into(),
+        );
         (shard::write(dir, header, &p).unwrap(), p)
     }
 

@@ -96,19 +96,14 @@ impl ShardAt<'_> {
         }
         let prepared = read_prepared(self.dir, self.stage, self.key, &bake)?;
         let (part, payload) = run.run_shard(ws, self.index, self.count, prepared, progress)?;
-        let header = ShardHeader {
+        let header = ShardHeader::new(
             bake,
-            stage: self.stage.into(),
-            index: self.index as u32,
-            count: self.count as u32,
-            key: self.key.into(),
-            relume_version: env!("CARGO_PKG_VERSION").into(),
-            pipeline: self.pipeline.clone(),
-            part: part.clone(),
-            facts: Default::default(),
-            sections: Vec::new(),
-            payload_bytes: 0,
-        };
+            self.stage.into(),
+            (self.index, self.count),
+            self.key,
+            self.pipeline,
+            part.clone(),
+        );
         let path = shard::write(self.dir, header, &payload)?;
         Ok(written(part, path, false))
     }
@@ -146,19 +141,14 @@ pub fn write_prepared(
     key: &str,
     payload: &Payload,
 ) -> Result<PathBuf> {
-    let header = ShardHeader {
-        bake: bake_id(pipeline)?,
-        stage: prepared_name(stage),
-        index: 0,
-        count: 1,
-        key: key.into(),
-        relume_version: env!("CARGO_PKG_VERSION").into(),
-        pipeline: pipeline.clone(),
-        part: format!("prepared once for the shards of `{stage}`"),
-        facts: Default::default(),
-        sections: Vec::new(),
-        payload_bytes: 0,
-    };
+    let header = ShardHeader::new(
+        bake_id(pipeline)?,
+        prepared_name(stage),
+        (0, 1),
+        key,
+        pipeline,
+        format!("prepared once for the shards of `{stage}`"),
+    );
     shard::write(dir, header, payload)
 }
 

@@ -58,10 +58,36 @@ pub struct ShardHeader {
     pub pipeline: Pipeline,
     /// What part of the stage this is, for people (`rows 0..150 of 600`).
     pub part: String,
-    /// Numbers the merge needs besides the arrays (e.g. the solver a transport shard used).
-    pub facts: BTreeMap<String, String>,
+    /// Filled in by [`write`].
     pub sections: Vec<Section>,
+    /// Filled in by [`write`].
     pub payload_bytes: u64,
+}
+
+impl ShardHeader {
+    /// The header of part `index` of `count` of `stage` of bake `bake` (sections and size are
+    /// filled in by [`write`]).
+    pub fn new(
+        bake: String,
+        stage: String,
+        (index, count): (usize, usize),
+        key: &str,
+        pipeline: &Pipeline,
+        part: String,
+    ) -> Self {
+        ShardHeader {
+            bake,
+            stage,
+            index: index as u32,
+            count: count as u32,
+            key: key.into(),
+            relume_version: env!("CARGO_PKG_VERSION").into(),
+            pipeline: pipeline.clone(),
+            part,
+            sections: Vec::new(),
+            payload_bytes: 0,
+        }
+    }
 }
 
 /// Writes a section's little-endian bytes, piece by piece, into a sink.
