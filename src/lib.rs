@@ -22,5 +22,6 @@ pub mod render;
 pub mod scene;
 pub mod study;
 pub mod terrain;
+pub mod theme;
 
 pub use error::{Error, Result};

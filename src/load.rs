@@ -1,5 +1,7 @@
 //! Loading a pipeline's input (scene or height map) and summarising it for `relume-bake load`.
 
+pub mod themes;
+
 use crate::error::{Error, Result};
 use crate::heightmap::{load_heightmap, HeightMap, HeightMapInfo, HeightMapOptions};
 use crate::pipeline::Input;

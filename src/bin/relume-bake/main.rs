@@ -9,6 +9,7 @@ mod scale;
 mod study;
 mod sun_args;
 mod terrain;
+mod theme;
 mod ui;
 
 use clap::{Args, Parser, Subcommand};
@@ -111,6 +112,9 @@ enum Command {
     /// Soft shadows of the sun's disc (penumbrae, curved planets): lit fraction and shaded relief
     #[command(after_help = EXIT_CODES)]
     Softshadow(terrain::SoftShadowArgs),
+    /// Compose a theme set's albedo (thematic textures with fractal borders) at any resolution
+    #[command(after_help = EXIT_CODES)]
+    Theme(theme::ThemeArgs),
     /// Write a synthetic height map: stress maps (spikes, steps) and analytic shapes
     Generate(terrain::GenerateArgs),
     /// Load a scene (.obj .gltf .glb) or height map (.png .jpg .exr .tif .raw) and summarise it
@@ -352,6 +356,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
         Command::Softshadow(a) => terrain::softshadow(a, ui, cli.global.quiet, json),
         Command::Horizon(a) => horizon::horizon(a, ui, cli.global.quiet, json),
         Command::Sunlight(a) => horizon::sunlight_cmd(a, ui, cli.global.quiet, json),
+        Command::Theme(a) => theme::run(a, ui, json),
         Command::Generate(a) => terrain::generate_cmd(a, cli.global.quiet, json),
         Command::Load { file, knobs } => {
             let loaded = load_any(
