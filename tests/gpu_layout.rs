@@ -67,6 +67,7 @@ fn shared_structs() -> Vec<Shared> {
     use relume::gpu::freeform_shader::ShadeFrameU;
     use relume::gpu::mesh_renderer::FrameUniform;
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
+    use relume::gpu::themes::ThemeParams;
     vec![
         shared!("lighting.wgsl", "GpuLight", GpuLight {
             "position": field!(GpuLight, position),
@@ -139,6 +140,22 @@ fn shared_structs() -> Vec<Shared> {
             "flags": field!(TerrainFrame, flags),
             "min_height": field!(TerrainFrame, min_height),
             "max_height_tint": field!(TerrainFrame, max_height_tint),
+        }),
+        shared!("theme.wgsl", "ThemeParams", ThemeParams {
+            "words_at": field!(ThemeParams, words_at),
+            "exceptions_at": field!(ThemeParams, exceptions_at),
+            "textures_at": field!(ThemeParams, textures_at),
+            "noise_at": field!(ThemeParams, noise_at),
+            "lut_at": field!(ThemeParams, lut_at),
+            "classes_at": field!(ThemeParams, classes_at),
+            "levels_at": field!(ThemeParams, levels_at),
+            "index_levels": field!(ThemeParams, index_levels),
+            "tex_size": field!(ThemeParams, tex_size),
+            "tex_levels": field!(ThemeParams, tex_levels),
+            "per_theme": field!(ThemeParams, per_theme),
+            "noise_size": field!(ThemeParams, noise_size),
+            "shift": field!(ThemeParams, shift),
+            "index_size": field!(ThemeParams, index_size),
         }),
         shared!("terrain_shadow.wgsl", "TerrainParams", TerrainParams {
             "width": field!(TerrainParams, width),

@@ -86,11 +86,23 @@ pub fn dispatch(
     group: &wgpu::BindGroup,
     workgroups: [u32; 3],
 ) {
+    dispatch_groups(gpu, pipeline, &[(0, group)], workgroups)
+}
+
+/// Dispatch once with bind groups at the given indices, and wait.
+pub fn dispatch_groups(
+    gpu: &Gpu,
+    pipeline: &wgpu::ComputePipeline,
+    groups: &[(u32, &wgpu::BindGroup)],
+    workgroups: [u32; 3],
+) {
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, group, &[]);
+        for (i, g) in groups {
+            pass.set_bind_group(*i, *g, &[]);
+        }
         pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
     }
     gpu.queue.submit([enc.finish()]);

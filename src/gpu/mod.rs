@@ -15,6 +15,7 @@ pub mod radiosity_runtime;
 pub mod readback;
 pub mod render_target;
 pub mod terrain_renderer;
+pub mod themes;
 pub mod timing;
 
 use crate::error::{Error, Result};
@@ -191,6 +192,8 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "terrain_mask.wgsl",
     "terrain_render.wgsl",
     "terrain_shadow.wgsl",
+    "theme.wgsl",
+    "theme_kernel.wgsl",
     "tonemap_test.wgsl",
 ];
 

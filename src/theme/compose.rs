@@ -13,6 +13,20 @@ fn lod(footprint: f32) -> f32 {
     footprint.max(1.0).log2()
 }
 
+/// The blend zone's taps: eight directions 45° apart, then the centre (constants, so that
+/// both twins use the same bits).
+pub const BLEND_TAPS: [[f32; 2]; 9] = [
+    [1.0, 0.0],
+    [0.707_106_77, 0.707_106_77],
+    [0.0, 1.0],
+    [-0.707_106_77, 0.707_106_77],
+    [-1.0, 0.0],
+    [-0.707_106_77, -0.707_106_77],
+    [0.0, -1.0],
+    [0.707_106_77, -0.707_106_77],
+    [0.0, 0.0],
+];
+
 /// Per-lookup constants shared by every texel of a frame.
 pub struct Lookup<'a> {
     pub set: &'a ThemeSet,
@@ -102,13 +116,8 @@ impl Lookup<'_> {
         if let Border::Blend { width } = border {
             // Nine taps: the centre and eight around it at the zone's width.
             let mut sum = [0.0f32; 3];
-            for k in 0..9 {
-                let q = if k == 8 {
-                    p
-                } else {
-                    let a = k as f32 * std::f32::consts::FRAC_PI_4;
-                    [p[0] + width * a.cos(), p[1] + width * a.sin()]
-                };
+            for d in BLEND_TAPS {
+                let q = [p[0] + width * d[0], p[1] + width * d[1]];
                 let rgb = self.theme_texel(self.class_at(level, q), p, footprint);
                 sum = [0, 1, 2].map(|i| sum[i] + rgb[i]);
             }
