@@ -75,6 +75,13 @@ impl StageCache {
             baked::FORMAT_VERSION,
             ron::to_string(stage).expect("stage knobs serialise")
         );
+        // A stage that reads files of its own keys on their contents too.
+        if let Stage::Themes(k) = stage {
+            for f in crate::load::themes::theme_files(&k.file) {
+                let digest = hash_file(&f).map_or_else(|_| "unreadable".into(), |(n, h)| format!("{n} {h}"));
+                text += &format!("reads {} {digest}\n", f.display());
+            }
+        }
         let mut sorted: Vec<&FileRecord> = files.iter().collect();
         sorted.sort_by(|a, b| a.name.cmp(&b.name));
         for f in sorted {

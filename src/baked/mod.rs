@@ -23,6 +23,7 @@ pub mod patches;
 pub mod permutation;
 pub mod scene;
 pub mod shard;
+pub mod themes;
 pub(crate) mod transaction;
 pub mod transport;
 

@@ -47,6 +47,35 @@ pub fn load_themes(path: &Path, heightmap: Option<&HeightMap>) -> Result<ThemeSe
     Ok(spec.assemble(map, extra, &pngs))
 }
 
+/// The files a theme set reads (itself first, then what it names), for content-keyed
+/// caching; a file that cannot be parsed lists only itself.
+pub fn theme_files(path: &Path) -> Vec<PathBuf> {
+    let mut out = vec![path.to_path_buf()];
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return out;
+    };
+    let Ok(spec) = parse_themes(path, &text) else {
+        return out;
+    };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    match &spec.map {
+        MapSpec::Rules {
+            heightmap: Some(h), ..
+        } => out.push(dir.join(h)),
+        MapSpec::Image { path: p, .. } => out.push(dir.join(p)),
+        MapSpec::Polygons {
+            geojson: Some(g), ..
+        } => out.push(dir.join(g)),
+        _ => {}
+    }
+    for t in &spec.themes {
+        if let TextureSource::Png(p) = &t.texture {
+            out.push(dir.join(p));
+        }
+    }
+    out
+}
+
 fn index_map_of(
     path: &Path,
     dir: &Path,

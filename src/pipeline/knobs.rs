@@ -252,6 +252,15 @@ pub struct HorizonMapsKnobs {
     pub planet_radius: Option<f64>,
 }
 
+/// Knobs of `Themes(file: "THEMES.ron")`: the theme set (docs/themes.md) whose index map,
+/// textures and turbulence the bake stores (`themes.bin`). The path is relative to the
+/// pipeline file; a `Rules` map that names no height map uses the pipeline's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThemesKnobs {
+    pub file: std::path::PathBuf,
+}
+
 /// The default number of horizon azimuths.
 pub const DEFAULT_HORIZON_DIRECTIONS: u32 = 64;
 

@@ -10,7 +10,7 @@ use std::path::Path;
 
 /// Stage names that belong to relume's design but are not implemented by this version. A
 /// pipeline naming one is rejected as "not yet supported", never silently ignored.
-pub const PLANNED_STAGES: &[&str] = &["SoftShadow", "Freeform", "Theme", "Atmosphere"];
+pub const PLANNED_STAGES: &[&str] = &["SoftShadow", "Freeform", "Atmosphere"];
 
 const PIPELINE_FORMAT: RonFormat = RonFormat {
     reference: "the pipeline reference in README.md",
@@ -25,6 +25,13 @@ pub fn parse_pipeline(path: &Path) -> Result<Pipeline> {
     let mut pipeline = parse_str(path, &text)?;
     let base = path.parent().unwrap_or(Path::new("."));
     pipeline.input.resolve(base);
+    for stage in &mut pipeline.stages {
+        if let super::Stage::Themes(k) = stage {
+            if k.file.is_relative() {
+                k.file = base.join(&k.file);
+            }
+        }
+    }
     super::stage::check_order(path, &pipeline)?;
     Ok(pipeline)
 }

@@ -3,7 +3,7 @@
 
 use super::knobs::{
     EncodeKnobs, FormFactorsKnobs, HorizonMapsKnobs, MinmaxMipmapKnobs, ReorderKnobs,
-    TransportKnobs, VoxelizeKnobs,
+    ThemesKnobs, TransportKnobs, VoxelizeKnobs,
 };
 use super::Pipeline;
 use crate::error::{Error, Result};
@@ -27,6 +27,8 @@ pub enum Stage {
     MinmaxMipmap(MinmaxMipmapKnobs),
     /// Horizon maps of a height map (`horizon_maps.npy`, `horizon_directions.npy`).
     HorizonMaps(HorizonMapsKnobs),
+    /// Thematic textures of a height map from a theme set (`themes.bin`; docs/themes.md).
+    Themes(ThemesKnobs),
 }
 
 /// The name of a stage without its knobs. Declaration order is pipeline order: running a stage
@@ -40,6 +42,7 @@ pub enum StageKind {
     Encode,
     MinmaxMipmap,
     HorizonMaps,
+    Themes,
 }
 
 impl Stage {
@@ -53,6 +56,7 @@ impl Stage {
             Stage::Encode(_) => StageKind::Encode,
             Stage::MinmaxMipmap(_) => StageKind::MinmaxMipmap,
             Stage::HorizonMaps(_) => StageKind::HorizonMaps,
+            Stage::Themes(_) => StageKind::Themes,
         }
     }
 }
@@ -68,6 +72,7 @@ impl StageKind {
             StageKind::Encode => "encode",
             StageKind::MinmaxMipmap => "minmax_mipmap",
             StageKind::HorizonMaps => "horizon_maps",
+            StageKind::Themes => "themes",
         }
     }
 
@@ -76,7 +81,7 @@ impl StageKind {
         match self {
             StageKind::Voxelize | StageKind::FormFactors | StageKind::Transport => "scene",
             StageKind::Reorder | StageKind::Encode => "scene",
-            StageKind::MinmaxMipmap | StageKind::HorizonMaps => "heightmap",
+            StageKind::MinmaxMipmap | StageKind::HorizonMaps | StageKind::Themes => "heightmap",
         }
     }
 
@@ -87,7 +92,7 @@ impl StageKind {
             StageKind::FormFactors => &[StageKind::Voxelize],
             StageKind::Transport => &[StageKind::Voxelize, StageKind::FormFactors],
             StageKind::Reorder | StageKind::Encode => &[StageKind::Transport],
-            StageKind::MinmaxMipmap | StageKind::HorizonMaps => &[],
+            StageKind::MinmaxMipmap | StageKind::HorizonMaps | StageKind::Themes => &[],
         }
     }
 }

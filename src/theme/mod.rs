@@ -97,7 +97,7 @@ impl Default for Tiling {
 }
 
 /// One entry of the index map: which theme texture fills it and how its border looks.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Class {
     /// Index into the theme textures.
     pub theme: u32,

@@ -93,6 +93,7 @@ pub fn runner(stage: &Stage) -> &dyn StageRun {
         Stage::Encode(k) => k,
         Stage::MinmaxMipmap(k) => k,
         Stage::HorizonMaps(k) => k,
+        Stage::Themes(k) => k,
     }
 }
 

@@ -1,11 +1,11 @@
-//! The height-map stages: `minmax_mipmap`, `horizon_maps`.
+//! The height-map stages: `minmax_mipmap`, `horizon_maps`, `themes`.
 
 use super::{record, StageRun};
 use crate::bake::estimate::{PlanState, PlannedStage};
 use crate::bake::workspace::Workspace;
 use crate::baked::{self, BakeTransaction, StageRecord};
 use crate::error::Result;
-use crate::pipeline::knobs::{HorizonMapsKnobs, MinmaxMipmapKnobs};
+use crate::pipeline::knobs::{HorizonMapsKnobs, MinmaxMipmapKnobs, ThemesKnobs};
 use crate::progress::Progress;
 use crate::terrain::horizon_map::HorizonMap;
 use crate::terrain::minmax_mipmap::{level_sizes, MinMaxMipmap};
@@ -108,6 +108,53 @@ impl StageRun for HorizonMapsKnobs {
             peak_bytes: peak,
             output_bytes: planes + n * 8,
             notes: format!("{n} directions x {texels} texels, u16"),
+        }
+    }
+}
+
+impl StageRun for ThemesKnobs {
+    fn run(
+        &self,
+        ws: &mut Workspace,
+        txn: &mut BakeTransaction,
+        progress: &dyn Progress,
+    ) -> Result<StageRecord> {
+        progress.begin(baked::themes::STAGE, 0);
+        let set = crate::load::themes::load_themes(&self.file, Some(ws.heightmap()?))?;
+        baked::themes::write(txn, &set)?;
+        progress.finish();
+        let mut rec = record(baked::themes::STAGE, &[baked::themes::FILE]);
+        let base = &set.index.levels[0];
+        let m = set.memory();
+        rec.report.insert("themes".into(), set.themes.len() as f64);
+        rec.report.insert("classes".into(), set.classes.len() as f64);
+        rec.report.insert("index_width".into(), base.width as f64);
+        rec.report.insert("index_height".into(), base.height as f64);
+        rec.report.insert("index_levels".into(), set.index.levels.len() as f64);
+        rec.report.insert("bytes_index_ccc".into(), m.index_ccc as f64);
+        rec.report.insert("bytes_index_raw".into(), m.index_raw as f64);
+        rec.report.insert("bytes_total".into(), m.total as f64);
+        rec.report.insert("bytes_global_rgb8_index_res".into(), m.global_rgb8_index_res as f64);
+        rec.facts.insert(
+            "layout".into(),
+            "themes.bin: RLTHEME1, u32 header length, JSON header, level-0 index map as CCC words \
+             (u32) + exception blocks (16 B), theme texels RGBA8 (mip chains), turbulence f32 pairs"
+                .into(),
+        );
+        Ok(rec)
+    }
+
+    fn estimate(&self, state: &mut PlanState) -> PlannedStage {
+        // The index map at the height map's size (a Rules map; other sources are usually no
+        // larger), its levels (4/3) and its compressed copy, plus a 256² noise map and
+        // textures.
+        let (w, h) = state.map_size;
+        let texels = w.max(1) * h.max(1);
+        PlannedStage {
+            stage: baked::themes::STAGE.into(),
+            peak_bytes: texels * 2 + (1 << 20) * 2,
+            output_bytes: texels / 4 + (1 << 20),
+            notes: format!("index map of about {texels} texels, CCC"),
         }
     }
 }
