@@ -16,6 +16,7 @@
 
 use super::twin::{self, *};
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// All four tables, built for one eye altitude and sun (`AtmosphereGpu::radii`, `sun`).
 #[derive(Clone, Debug, PartialEq)]
@@ -253,19 +254,23 @@ impl Luts {
         let p = params;
         let [tw, th] = TRANSMITTANCE_SIZE;
         let transmittance: Vec<_> = (0..tw * th)
+            .into_par_iter()
             .map(|n| transmittance_texel(p, n % tw, n / tw))
             .collect();
         let [mw, mh] = MULTI_SCATTERING_SIZE;
         let multi_scattering: Vec<_> = (0..mw * mh)
+            .into_par_iter()
             .map(|n| multi_scattering_texel(p, &transmittance, n % mw, n / mw))
             .collect();
         let [sw, sh] = SKY_VIEW_SIZE;
         let sky_view: Vec<_> = (0..sw * sh)
+            .into_par_iter()
             .map(|n| sky_view_texel(p, &transmittance, &multi_scattering, n % sw, n / sw))
             .collect();
         let [ax, ay, az] = AERIAL_SIZE;
         let aerial: Vec<_> = (0..ax * ay * az)
-            .flat_map(|n| {
+            .into_par_iter()
+            .flat_map_iter(|n| {
                 aerial_texels(
                     p,
                     &transmittance,

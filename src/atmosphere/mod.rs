@@ -212,7 +212,8 @@ pub fn ray_sphere(o: DVec3, d: DVec3, r: f64) -> Option<(f64, f64)> {
 /// shell.
 pub fn ray_exit(atm: &Atmosphere, o: DVec3, d: DVec3) -> (f64, bool) {
     if let Some((near, _)) = ray_sphere(o, d, atm.ground_radius) {
-        if near > 0.0 {
+        // 1 mm: a point on the ground leaving it does not meet it again.
+        if near > 1e-3 {
             return (near, true);
         }
     }

@@ -230,7 +230,7 @@ fn continue_path(
         } else if ground {
             x += exit * d;
             let n = x.normalize();
-            x = n * atm.ground_radius * (1.0 + 1e-12);
+            x = n * (atm.ground_radius + 1e-3);
             let cos_sun = n.dot(sc.sun);
             if cos_sun > 0.0 {
                 let ts = reference::sun_transmittance_scaled(atm, x, sc.sun, sc.opts.sun_panel_scale);
