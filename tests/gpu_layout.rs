@@ -67,7 +67,18 @@ fn shared_structs() -> Vec<Shared> {
     use relume::gpu::freeform_shader::ShadeFrameU;
     use relume::gpu::mesh_renderer::FrameUniform;
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
+    use relume::atmosphere::twin::AtmosphereGpu;
     vec![
+        shared!("atmosphere.wgsl", "AtmosphereParams", AtmosphereGpu {
+            "rayleigh": field!(AtmosphereGpu, rayleigh),
+            "mie_scattering": field!(AtmosphereGpu, mie_scattering),
+            "mie_extinction": field!(AtmosphereGpu, mie_extinction),
+            "ozone": field!(AtmosphereGpu, ozone),
+            "ground_albedo": field!(AtmosphereGpu, ground_albedo),
+            "sun_illuminance": field!(AtmosphereGpu, sun_illuminance),
+            "radii": field!(AtmosphereGpu, radii),
+            "sun": field!(AtmosphereGpu, sun),
+        }),
         shared!("lighting.wgsl", "GpuLight", GpuLight {
             "position": field!(GpuLight, position),
             "direction": field!(GpuLight, direction),
