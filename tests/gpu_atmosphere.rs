@@ -45,17 +45,33 @@ fn tables_match_their_cpu_twins() {
             .read(&gpu, &p)
             .unwrap();
         // Relative to the larger of the value and 1e-3 of the table's largest value.
-        let floor = |t: &[[f32; 4]]| 1e-3 * t.iter().map(|v| v[0].max(v[1]).max(v[2])).fold(0.0, f32::max);
+        let floor = |t: &[[f32; 4]]| {
+            1e-3 * t
+                .iter()
+                .map(|v| v[0].max(v[1]).max(v[2]))
+                .fold(0.0, f32::max)
+        };
         let d = [
-            max_rel(&got.transmittance, &cpu.transmittance, floor(&cpu.transmittance)),
-            max_rel(&got.multi_scattering, &cpu.multi_scattering, floor(&cpu.multi_scattering)),
+            max_rel(
+                &got.transmittance,
+                &cpu.transmittance,
+                floor(&cpu.transmittance),
+            ),
+            max_rel(
+                &got.multi_scattering,
+                &cpu.multi_scattering,
+                floor(&cpu.multi_scattering),
+            ),
             max_rel(&got.sky_view, &cpu.sky_view, floor(&cpu.sky_view)),
             max_rel(&got.aerial, &cpu.aerial, floor(&cpu.aerial)),
         ];
         eprintln!("sun {sun_el}°: max rel. GPU − CPU (transmittance, multi, sky, aerial) = {d:?}");
         // Measured on lavapipe (Mesa 25): at most 1.3e-3 (aerial, sun 30°; f32 exp/acos of
         // the two compilers compounded over 20 steps); 4× margin.
-        for (name, v) in ["transmittance", "multi scattering", "sky view", "aerial"].iter().zip(d) {
+        for (name, v) in ["transmittance", "multi scattering", "sky view", "aerial"]
+            .iter()
+            .zip(d)
+        {
             assert!(v < 5e-3, "{name}: {v}");
         }
     }
@@ -105,7 +121,10 @@ fn lookups_match_their_cpu_twins() {
     eprintln!("max rel. GPU − CPU lookups (sky, aerial L, aerial T, fog) = {worst:?}");
     // Measured on lavapipe: sky 5.1e-4, aerial L 6.2e-4, aerial T 2.9e-4 (acos/sqrt of the
     // parameterisation moving a lookup along a steep table), fog 1.9e-7; 5× margin.
-    for (name, v) in ["sky", "aerial in-scattering", "aerial transmittance", "fog"].iter().zip(worst) {
+    for (name, v) in ["sky", "aerial in-scattering", "aerial transmittance", "fog"]
+        .iter()
+        .zip(worst)
+    {
         assert!(v < 3e-3, "{name}: {v}");
     }
 }

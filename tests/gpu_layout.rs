@@ -61,13 +61,13 @@ fn words(shader: &'static str, wgsl: &'static str, names: &[&'static str]) -> Sh
 }
 
 fn shared_structs() -> Vec<Shared> {
+    use relume::atmosphere::twin::AtmosphereGpu;
     use relume::freeform::twin::{GpuBump, GpuLeaf};
     use relume::gpu::compressed_gather::Params as GatherParams;
     use relume::gpu::freeform_caster::FrameU as FreeformFrame;
     use relume::gpu::freeform_shader::ShadeFrameU;
     use relume::gpu::mesh_renderer::FrameUniform;
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
-    use relume::atmosphere::twin::AtmosphereGpu;
     vec![
         shared!("atmosphere.wgsl", "AtmosphereParams", AtmosphereGpu {
             "rayleigh": field!(AtmosphereGpu, rayleigh),

@@ -91,7 +91,11 @@ fn multi_direction(
 ) -> (Vec3, Vec3) {
     let t_ground = ray_sphere_nearest(o, dir, p.ground());
     let t_top = ray_sphere_nearest(o, dir, p.top());
-    let t_max = if t_ground >= 0.0 { t_ground } else { t_top.max(0.0) };
+    let t_max = if t_ground >= 0.0 {
+        t_ground
+    } else {
+        t_top.max(0.0)
+    };
     let n = STEPS[1];
     let dt = t_max / n as f32;
     let iso = 1.0 / (4.0 * std::f32::consts::PI);

@@ -14,6 +14,9 @@
 //!
 //! Deterministic: one PCG stream per call, seeded by [`McOptions::seed`].
 
+// Per-channel loops index several RGB arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use super::reference::{self, ViewRay};
 use super::{cornette_shanks_phase, henyey_greenstein_phase, rayleigh_phase, Atmosphere};
 use glam::DVec3;
@@ -105,7 +108,10 @@ impl Scatter<'_> {
         let m = atm.medium(atm.altitude(x));
         let mu_sun = d.dot(self.sun);
         let ts = reference::sun_transmittance_scaled(atm, x, self.sun, self.opts.sun_panel_scale);
-        let (pr, pm) = (rayleigh_phase(mu_sun), cornette_shanks_phase(mu_sun, atm.mie_g));
+        let (pr, pm) = (
+            rayleigh_phase(mu_sun),
+            cornette_shanks_phase(mu_sun, atm.mie_g),
+        );
         let nee: [f64; 3] = std::array::from_fn(|c| {
             w[c] * (m.rayleigh[c] * pr + m.mie[c] * pm) / norm * ts[c] * atm.sun_illuminance[c]
         });
@@ -122,7 +128,10 @@ impl Scatter<'_> {
         };
         let nd = around(d, cos_t, phi);
         let q = p_r / (4.0 * PI) + (1.0 - p_r) * henyey_greenstein_phase(cos_t, atm.mie_g);
-        let (pr, pm) = (rayleigh_phase(cos_t), cornette_shanks_phase(cos_t, atm.mie_g));
+        let (pr, pm) = (
+            rayleigh_phase(cos_t),
+            cornette_shanks_phase(cos_t, atm.mie_g),
+        );
         for c in 0..3 {
             w[c] *= (m.rayleigh[c] * pr + m.mie[c] * pm) / (norm * q);
         }
@@ -145,7 +154,7 @@ pub fn trace(atm: &Atmosphere, ray: &ViewRay, opts: &McOptions) -> McResult {
         .collect();
     let total: f64 = q.iter().sum();
     let mut out = McResult::default();
-    if !(total > 0.0) || opts.paths == 0 {
+    if total.is_nan() || total <= 0.0 || opts.paths == 0 {
         return out;
     }
     let mut cdf = Vec::with_capacity(q.len());
@@ -233,12 +242,11 @@ fn continue_path(
             x = n * (atm.ground_radius + 1e-3);
             let cos_sun = n.dot(sc.sun);
             if cos_sun > 0.0 {
-                let ts = reference::sun_transmittance_scaled(atm, x, sc.sun, sc.opts.sun_panel_scale);
+                let ts =
+                    reference::sun_transmittance_scaled(atm, x, sc.sun, sc.opts.sun_panel_scale);
                 for c in 0..3 {
-                    sum[c] += w[c] * atm.ground_albedo[c] / PI
-                        * cos_sun
-                        * ts[c]
-                        * atm.sun_illuminance[c];
+                    sum[c] +=
+                        w[c] * atm.ground_albedo[c] / PI * cos_sun * ts[c] * atm.sun_illuminance[c];
                 }
             }
             for c in 0..3 {

@@ -190,7 +190,14 @@ pub struct Node {
 pub fn view_nodes(atm: &Atmosphere, ray: &ViewRay) -> (Vec<Node>, [f64; 3]) {
     let (eye, length) = ray.start_and_length(atm);
     let d = ray.dir;
-    let ends = panels(atm, eye, d, length, &shadow_breaks(atm, eye, d, ray.sun), 1.0);
+    let ends = panels(
+        atm,
+        eye,
+        d,
+        length,
+        &shadow_breaks(atm, eye, d, ray.sun),
+        1.0,
+    );
     let mut tau0 = [0.0; 3];
     let mut nodes = Vec::with_capacity(8 * ends.len());
     for w in ends.windows(2) {

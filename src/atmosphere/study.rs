@@ -107,10 +107,7 @@ pub fn reference_inscatter(atm: &Atmosphere, ray: &ViewRay, mc: &McOptions) -> (
 
 /// The error table for `elevations` (degrees; the sun at azimuth 0).
 pub fn error_vs_elevation(atm: &Atmosphere, elevations: &[f64], views: &Views) -> Vec<Row> {
-    elevations
-        .iter()
-        .map(|&el| row(atm, el, views))
-        .collect()
+    elevations.iter().map(|&el| row(atm, el, views)).collect()
 }
 
 fn row(atm: &Atmosphere, sun_el: f64, views: &Views) -> Row {
@@ -144,7 +141,9 @@ fn row(atm: &Atmosphere, sun_el: f64, views: &Views) -> Row {
         let end = eye + s * dir;
         let (f, ft) = fog.segment(eye, end);
         out.fog = out.fog.max(rel(f, want));
-        out.fog_attenuated_sun = out.fog_attenuated_sun.max(rel(fog_t.segment(eye, end).0, want));
+        out.fog_attenuated_sun = out
+            .fog_attenuated_sun
+            .max(rel(fog_t.segment(eye, end).0, want));
         out.fog_vs_single = out.fog_vs_single.max(rel(f, ss.inscatter));
         let fa = fog_t.segment(eye, end).0;
         out.fog_attenuated_vs_single = out.fog_attenuated_vs_single.max(rel(fa, ss.inscatter));
@@ -190,7 +189,13 @@ pub fn markdown(rows: &[Row]) -> String {
     let mut s = String::from(
         "| sun ° | Hillaire aerial | Hillaire march | Hillaire sky | seed fog | fog, sun attenuated | seed fog vs single | attenuated vs single | single only | fog ΔT | ref. MC rel. SE |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    let pc = |x: f64| format!("{:.1} %", 100.0 * x);
+    let pc = |x: f64| {
+        if x > 100.0 {
+            "> 10⁴ %".to_string()
+        } else {
+            format!("{:.1} %", 100.0 * x)
+        }
+    };
     for r in rows {
         s.push_str(&format!(
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} |\n",

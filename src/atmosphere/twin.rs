@@ -237,7 +237,10 @@ pub fn angles_dir(theta: f32, phi: f32) -> Vec3 {
 pub fn sample2(tab: &[[f32; 4]], nx: usize, ny: usize, x: f32, y: f32) -> Vec3 {
     let fx = x.clamp(0.0, 1.0) * (nx - 1) as f32;
     let fy = y.clamp(0.0, 1.0) * (ny - 1) as f32;
-    let (x0, y0) = ((fx.floor() as usize).min(nx - 1), (fy.floor() as usize).min(ny - 1));
+    let (x0, y0) = (
+        (fx.floor() as usize).min(nx - 1),
+        (fy.floor() as usize).min(ny - 1),
+    );
     let (x1, y1) = ((x0 + 1).min(nx - 1), (y0 + 1).min(ny - 1));
     let (ax, ay) = (fx - x0 as f32, fy - y0 as f32);
     let t = |i: usize, j: usize| v3(tab[j * nx + i]);

@@ -50,15 +50,15 @@ fn bind(
     })
 }
 
-fn run(
-    gpu: &Gpu,
-    entry: &str,
-    entries: &[(u32, &wgpu::Buffer)],
-    invocations: usize,
-) -> Result<()> {
+fn run(gpu: &Gpu, entry: &str, entries: &[(u32, &wgpu::Buffer)], invocations: usize) -> Result<()> {
     let pipeline = compute::pipeline(gpu, SHADER, entry)?;
     let group = bind(gpu, &pipeline, entries);
-    compute::dispatch(gpu, &pipeline, &group, [invocations.div_ceil(64) as u32, 1, 1]);
+    compute::dispatch(
+        gpu,
+        &pipeline,
+        &group,
+        [invocations.div_ceil(64) as u32, 1, 1],
+    );
     Ok(())
 }
 
@@ -86,7 +86,11 @@ impl AtmosphereTables {
         run(
             gpu,
             "build_multi_scattering",
-            &[(0, &t.params), (1, &t.transmittance), (5, &t.multi_scattering)],
+            &[
+                (0, &t.params),
+                (1, &t.transmittance),
+                (5, &t.multi_scattering),
+            ],
             mw * mh,
         )?;
         let read = [
@@ -113,7 +117,9 @@ impl AtmosphereTables {
     pub fn read(&self, gpu: &Gpu, params: &AtmosphereGpu) -> Result<Luts> {
         let quads = |b: &wgpu::Buffer| -> Result<Vec<[f32; 4]>> {
             let f = readback::read_f32(gpu, b)?;
-            Ok(f.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
+            Ok(f.chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect())
         };
         Ok(Luts {
             params: *params,
