@@ -11,10 +11,10 @@
 //!   the distance to the top along μ, x_μ = (d − d_min)/(d_max − d_min), d_min = top − r,
 //!   d_max = ρ + H (Bruneton 2017; only rays that miss the ground).
 //! - multiple scattering (r, μ_s) → (μ_s/2 + 1/2, (r − R)/(top − R)).
-//! - sky view (view zenith θ, azimuth φ from the sun) at the eye: u = √(φ/π); with β the
-//!   angle below the horizontal of the horizon and θ_h = π − β... the horizon's zenith angle
-//!   θ_h = π/2 + (π/2 − acos(ρ/r)): v = ½·(1 − √(1 − θ/θ_h)) above the horizon, v = ½ + ½·√((θ −
-//!   θ_h)/(π − θ_h)) below (Hillaire's non-linear latitude, dense at the horizon).
+//! - sky view (view zenith θ, azimuth φ from the sun) at the eye: u = √(φ/π); with the
+//!   horizon's zenith angle θ_h = π − β, β = acos(ρ/r): v = ½·(1 − √(1 − θ/θ_h)) above the
+//!   horizon, v = ½ + ½·√((θ − θ_h)/β) below (Hillaire's non-linear latitude, dense at the
+//!   horizon).
 //! - aerial perspective (u, v as the sky view, w = √(s / s_max)).
 
 use glam::Vec3;
