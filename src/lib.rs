@@ -5,6 +5,7 @@
 //! plain data. Start at [`pipeline`] (what a bake is), [`bake`] (how it runs) and [`baked`] (what
 //! it writes).
 
+pub mod atmosphere;
 pub mod bake;
 pub mod baked;
 pub mod compress;

@@ -61,6 +61,7 @@ fn words(shader: &'static str, wgsl: &'static str, names: &[&'static str]) -> Sh
 }
 
 fn shared_structs() -> Vec<Shared> {
+    use relume::atmosphere::twin::AtmosphereGpu;
     use relume::freeform::twin::{GpuBump, GpuLeaf};
     use relume::gpu::compressed_gather::Params as GatherParams;
     use relume::gpu::freeform_caster::FrameU as FreeformFrame;
@@ -69,6 +70,16 @@ fn shared_structs() -> Vec<Shared> {
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
     use relume::gpu::themes::ThemeParams;
     vec![
+        shared!("atmosphere.wgsl", "AtmosphereParams", AtmosphereGpu {
+            "rayleigh": field!(AtmosphereGpu, rayleigh),
+            "mie_scattering": field!(AtmosphereGpu, mie_scattering),
+            "mie_extinction": field!(AtmosphereGpu, mie_extinction),
+            "ozone": field!(AtmosphereGpu, ozone),
+            "ground_albedo": field!(AtmosphereGpu, ground_albedo),
+            "sun_illuminance": field!(AtmosphereGpu, sun_illuminance),
+            "radii": field!(AtmosphereGpu, radii),
+            "sun": field!(AtmosphereGpu, sun),
+        }),
         shared!("lighting.wgsl", "GpuLight", GpuLight {
             "position": field!(GpuLight, position),
             "direction": field!(GpuLight, direction),

@@ -5,6 +5,7 @@
 //! (WGSL has no includes); [`shader_source`] does the concatenation for the device and the naga
 //! validation test alike.
 
+pub mod atmosphere;
 pub mod blit;
 pub mod compressed_gather;
 pub mod compute;
@@ -176,6 +177,7 @@ macro_rules! shaders {
 }
 
 pub const SHADERS: &[(&str, &str)] = shaders![
+    "atmosphere.wgsl",
     "blit.wgsl",
     "common.wgsl",
     "corner_interpolate.wgsl",
