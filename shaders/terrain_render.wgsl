@@ -4,6 +4,7 @@
 // perspective, tone map; soft shadows (the sun disc's lit fraction by branch-and-bound) on
 // request. Rust twin: relume::render::terrain_shading.
 //! include terrain_shadow.wgsl
+//! include theme.wgsl
 
 struct TerrainFrame {
     view_proj: mat4x4<f32>,
@@ -12,7 +13,7 @@ struct TerrainFrame {
     cell: vec4<f32>,           // cell_x, cell_y, vertical exaggeration, grid step (texels)
     fog: vec4<f32>,            // extinction per metre, scattering albedo, anisotropy g, sun strength
     exposure: f32,
-    flags: u32,                // bit 0 shadows, bit 1 fog, bit 2 soft shadows, bit 3 horizon maps
+    flags: u32,                // bit 0 shadows, bit 1 fog, bit 2 soft shadows, bit 3 horizon maps, bit 4 themes
     min_height: f32,
     max_height_tint: f32,
 }
@@ -73,12 +74,11 @@ fn tint(t_in: f32) -> vec3<f32> {
     return mix(mid, high, t * 2.0 - 1.0);
 }
 
-// Radiance of a texel (before fog): tint × (sun × Lambert × (1 − (1 − k)·shadow) + sky).
+// Radiance of a texel (before fog): albedo × (sun × Lambert × (1 − (1 − k)·shadow) + sky).
 // Rust twin: relume::render::terrain_shading::texel_radiance.
-fn texel_radiance(height: f32, lambert: f32, shadow: f32, k: f32) -> vec3<f32> {
-    let t = (height - frame.min_height) / max(frame.max_height_tint - frame.min_height, 1e-6);
+fn texel_radiance(albedo: vec3<f32>, lambert: f32, shadow: f32, k: f32) -> vec3<f32> {
     let relief = lambert * (1.0 - (1.0 - k) * shadow);
-    return tint(t) * (frame.fog.w * relief + 0.15);
+    return albedo * (frame.fog.w * relief + 0.15);
 }
 
 // Henyey-Greenstein phase function.
@@ -89,6 +89,10 @@ fn phase(cos_theta: f32, g: f32) -> f32 {
 
 @fragment
 fn fs_main(v: VOut) -> @location(0) vec4<f32> {
+    // Theme lookup position (index texels) and the pixel's footprint, taken here in uniform
+    // control flow: the index map spans the height map.
+    let tp = v.texel * (theme.index_size / vec2<f32>(f32(terrain.width), f32(terrain.height)));
+    let footprint = max(length(dpdx(tp)), length(dpdy(tp)));
     let col = clamp(i32(floor(v.texel.x)), 0, i32(terrain.width) - 1);
     let row = clamp(i32(floor(v.texel.y)), 0, i32(terrain.height) - 1);
     var shadow = 0.0;
@@ -101,7 +105,14 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
             shadow = 1.0;
         }
     }
-    var rgb = texel_radiance(height_at(col, row), lambert_at(col, row), shadow, frame.sun.w);
+    var albedo: vec3<f32>;
+    if ((frame.flags & 16u) != 0u) {
+        albedo = theme_albedo(tp, footprint);
+    } else {
+        let h = height_at(col, row);
+        albedo = tint((h - frame.min_height) / max(frame.max_height_tint - frame.min_height, 1e-6));
+    }
+    var rgb = texel_radiance(albedo, lambert_at(col, row), shadow, frame.sun.w);
     if ((frame.flags & 2u) != 0u) {
         // Aerial perspective (docs/algorithms.md §6): L = L0·e^(−β s) + E_sun·(β_sc/β_ext)·Φ(θ)·(1 − e^(−β s)).
         let to_eye = frame.eye.xyz - v.world;

@@ -131,7 +131,7 @@ fn map_view_difference(
     gpu.queue.submit([enc.finish()]);
     let img = r.target.read_image(gpu).unwrap();
     let shadow: Vec<f32> = shadow(r).iter().map(|&b| b as u8 as f32).collect();
-    let want = map_view(map, &sun, &shadow, &s);
+    let want = map_view(map, &sun, &shadow, &s, None);
     let (w, h) = (map.width as u32, map.height as u32);
     let (mut sum, mut n, mut worst) = (0u64, 0u64, 0u8);
     for y in 1..h - 1 {

@@ -78,7 +78,8 @@ impl StageCache {
         // A stage that reads files of its own keys on their contents too.
         if let Stage::Themes(k) = stage {
             for f in crate::load::themes::theme_files(&k.file) {
-                let digest = hash_file(&f).map_or_else(|_| "unreadable".into(), |(n, h)| format!("{n} {h}"));
+                let digest =
+                    hash_file(&f).map_or_else(|_| "unreadable".into(), |(n, h)| format!("{n} {h}"));
                 text += &format!("reads {} {digest}\n", f.display());
             }
         }

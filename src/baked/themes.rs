@@ -60,14 +60,22 @@ pub fn encode(set: &ThemeSet) -> Vec<u8> {
     out.extend(ccc.words.iter().flat_map(|w| w.to_le_bytes()));
     out.extend(ccc.exceptions.iter().flatten());
     out.extend(set.textures.texels.iter().flatten());
-    out.extend(set.noise.values.iter().flatten().flat_map(|v| v.to_le_bytes()));
+    out.extend(
+        set.noise
+            .values
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes()),
+    );
     out
 }
 
 /// Write the theme set into a bake.
 pub fn write(txn: &mut BakeTransaction, set: &ThemeSet) -> Result<()> {
     let bytes = encode(set);
-    txn.write_with(FILE, |p| std::fs::write(p, &bytes).map_err(|e| Error::io(p, "cannot write", e)))
+    txn.write_with(FILE, |p| {
+        std::fs::write(p, &bytes).map_err(|e| Error::io(p, "cannot write", e))
+    })
 }
 
 /// Read `themes.bin` from the bake in `dir`.
@@ -99,7 +107,9 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<ThemeSet, String> {
         || h.themes.is_empty()
         || h.classes.is_empty()
         || h.classes.len() > crate::theme::MAX_CLASSES
-        || h.classes.iter().any(|c| c.theme as usize >= h.themes.len() || c.border.check().is_err())
+        || h.classes
+            .iter()
+            .any(|c| c.theme as usize >= h.themes.len() || c.border.check().is_err())
     {
         return Err("the header's sizes or classes are inconsistent".into());
     }
@@ -119,7 +129,10 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<ThemeSet, String> {
     let ccc = Ccc {
         width: w,
         height: hgt,
-        words: words.chunks(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect(),
+        words: words
+            .chunks(4)
+            .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+            .collect(),
         exceptions: exc.chunks(16).map(|c| c.try_into().unwrap()).collect(),
         lossy_texels: 0,
     };
@@ -132,10 +145,17 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<ThemeSet, String> {
             a >= classes || b >= classes
         };
         if bad {
-            return Err("an index word names a class or exception block that does not exist".into());
+            return Err(
+                "an index word names a class or exception block that does not exist".into(),
+            );
         }
     }
-    if ccc.exceptions.iter().flatten().any(|&c| c as usize >= classes) {
+    if ccc
+        .exceptions
+        .iter()
+        .flatten()
+        .any(|&c| c as usize >= classes)
+    {
         return Err("an exception block names a class that does not exist".into());
     }
     let values: Vec<[f32; 2]> = noise

@@ -16,7 +16,8 @@ use std::path::PathBuf;
 const KEYS: &str = "\
 Window keys: mouse drag or arrows orbit, wheel or +/- zoom, J/L sun azimuth, I/K sun elevation,
 S sun on/off, 1 direct, 2 indirect, 3 shadows, 4 emission, 5 soft shadows, 6 fog, 7 terrain
-hard shadows from horizon maps / by traversal, [ ] exposure, Esc quit.";
+hard shadows from horizon maps / by traversal, 8 themes, 9 theme-border animation, [ ] exposure,
+Esc quit. Headless, frame K of --frames N shows the theme borders of animation frame K.";
 
 fn after_help() -> String {
     format!("{}\n\n{KEYS}", exit::HELP)
@@ -84,6 +85,12 @@ struct Cli {
     /// Terrain: no aerial perspective
     #[arg(long)]
     no_fog: bool,
+    /// Terrain: the hypsometric tint instead of the bake's thematic textures
+    #[arg(long)]
+    no_themes: bool,
+    /// Terrain: theme borders stay still from frame to frame
+    #[arg(long)]
+    no_theme_animation: bool,
     /// Transport to gather from: the encoded one when the bake has it (auto), or the dense
     /// `transport.npy` reference
     #[arg(long, value_enum, default_value_t = TransportChoice::Auto)]
@@ -124,6 +131,8 @@ fn settings(cli: &Cli) -> FrameSettings {
         soft_shadows: cli.soft,
         horizon_shadows: !cli.no_horizon,
         fog: !cli.no_fog,
+        themes: !cli.no_themes,
+        theme_animation: !cli.no_theme_animation,
         ..Default::default()
     }
 }

@@ -4,6 +4,8 @@
 //! `render::terrain_shading`).
 
 use super::render_target::{RenderTarget, DEPTH_FORMAT, TARGET_FORMAT};
+use super::terrain_buffers::{grid_mesh, TerrainBuffers};
+use super::themes::ThemeGpu;
 use super::{compute, timing::PassTimer, Gpu};
 use crate::error::{Error, Result};
 use crate::heightmap::HeightMap;
@@ -12,7 +14,6 @@ use crate::terrain::horizon_map::HorizonMap;
 use crate::terrain::sun::{Sun, Track, TrackKind};
 use crate::terrain::MinMaxMipmap;
 use glam::{Mat4, Vec3};
-use wgpu::util::DeviceExt;
 
 /// The `TerrainParams` uniform of `terrain_shadow.wgsl` (public for the layout test in
 /// tests/gpu_layout.rs).
@@ -95,6 +96,10 @@ pub struct TerrainRenderer {
     grid_step: u32,
     pub target: RenderTarget,
     sun: Sun,
+    /// The bake's theme set (a one-texel placeholder until [`TerrainRenderer::set_themes`]).
+    themes: ThemeGpu,
+    theme_group: wgpu::BindGroup,
+    has_themes: bool,
 }
 
 /// Most grid vertices along a side of the display mesh (the shading is per texel regardless).
@@ -224,6 +229,8 @@ impl TerrainRenderer {
             g0,
             terrain_entries(&render_pipeline.get_bind_group_layout(1)),
         ];
+        let themes = ThemeGpu::upload(gpu, &crate::theme::ThemeSet::placeholder());
+        let theme_group = themes.bind(gpu, &render_pipeline.get_bind_group_layout(2));
 
         let step = grid_step
             .unwrap_or_else(|| (map.width.max(map.height) as u32).div_ceil(MAX_GRID))
@@ -251,6 +258,9 @@ impl TerrainRenderer {
             grid_step: step,
             target: RenderTarget::new(gpu, width, height),
             sun: Sun::new(135.0, 30.0)?,
+            themes,
+            theme_group,
+            has_themes: false,
         };
         r.params_cpu.max_height = mip.max_height;
         r.params_cpu.min_height = mip.min_height;
@@ -445,7 +455,8 @@ impl TerrainRenderer {
             flags: s.shadows as u32
                 | (s.fog as u32) << 1
                 | (s.soft as u32) << 2
-                | ((s.horizon && self.horizon.is_some()) as u32) << 3,
+                | ((s.horizon && self.horizon.is_some()) as u32) << 3
+                | ((s.themes && self.has_themes) as u32) << 4,
             min_height: self.heights_range.0,
             max_height_tint: self.heights_range.1,
         };
@@ -455,9 +466,29 @@ impl TerrainRenderer {
         pass.set_pipeline(&self.render_pipeline);
         pass.set_bind_group(0, &self.render_groups[0], &[]);
         pass.set_bind_group(1, &self.render_groups[1], &[]);
+        pass.set_bind_group(2, &self.theme_group, &[]);
         pass.set_vertex_buffer(0, self.grid.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);
+    }
+
+    /// Texture the terrain with `set` (its index map spans the whole height map) instead of
+    /// the hypsometric tint.
+    pub fn set_themes(&mut self, gpu: &Gpu, set: &crate::theme::ThemeSet) {
+        self.themes = ThemeGpu::upload(gpu, set);
+        self.theme_group = self
+            .themes
+            .bind(gpu, &self.render_pipeline.get_bind_group_layout(2));
+        self.has_themes = true;
+    }
+
+    pub fn has_themes(&self) -> bool {
+        self.has_themes
+    }
+
+    /// Move the theme borders to animation shift `shift` ([`crate::theme::ThemeSet::shift`]).
+    pub fn set_theme_shift(&mut self, gpu: &Gpu, shift: [f32; 2]) {
+        self.themes.set_shift(gpu, shift);
     }
 
     pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
@@ -478,82 +509,4 @@ impl TerrainRenderer {
         let proj = crate::render::camera::orthographic(0.0, w, -h, 0.0, 0.0, 2.0 * top + 1.0);
         (proj * view, eye)
     }
-}
-
-/// The storage buffers of group 1 (`terrain_shadow.wgsl`).
-struct TerrainBuffers {
-    params: wgpu::Buffer,
-    heights: wgpu::Buffer,
-    mip_data: wgpu::Buffer,
-    mip_levels: wgpu::Buffer,
-    horizon_pair: wgpu::Buffer,
-}
-
-impl TerrainBuffers {
-    /// Group 1 of a pipeline that includes `terrain_shadow.wgsl`.
-    fn bind(&self, gpu: &Gpu, layout: &wgpu::BindGroupLayout) -> wgpu::BindGroup {
-        let entries: Vec<wgpu::BindGroupEntry> = [
-            &self.params,
-            &self.heights,
-            &self.mip_data,
-            &self.mip_levels,
-            &self.horizon_pair,
-        ]
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: b.as_entire_binding(),
-        })
-        .collect();
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("terrain"),
-            layout,
-            entries: &entries,
-        })
-    }
-}
-
-/// Grid vertices at texel centres every `step` texels (always including the last row and
-/// column) and two triangles per cell.
-fn grid_mesh(gpu: &Gpu, w: u32, h: u32, step: u32) -> (wgpu::Buffer, wgpu::Buffer, u32) {
-    let axis = |n: u32| -> Vec<u32> {
-        let mut v: Vec<u32> = (0..n).step_by(step as usize).collect();
-        if *v.last().unwrap() != n - 1 {
-            v.push(n - 1);
-        }
-        v
-    };
-    let (xs, ys) = (axis(w), axis(h));
-    let verts: Vec<[f32; 2]> = ys
-        .iter()
-        .flat_map(|&y| xs.iter().map(move |&x| [x as f32 + 0.5, y as f32 + 0.5]))
-        .collect();
-    let nx = xs.len() as u32;
-    let mut idx = Vec::new();
-    for j in 0..ys.len() as u32 - 1 {
-        for i in 0..nx - 1 {
-            let a = j * nx + i;
-            idx.extend_from_slice(&[a, a + nx, a + 1, a + 1, a + nx, a + nx + 1]);
-        }
-    }
-    if idx.is_empty() {
-        // A one-texel-wide map: a degenerate strip still draws nothing; keep the buffer valid.
-        idx.extend_from_slice(&[0, 0, 0]);
-    }
-    let vb = gpu
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("terrain grid"),
-            contents: bytemuck::cast_slice(&verts),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-    let ib = gpu
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("terrain indices"),
-            contents: bytemuck::cast_slice(&idx),
-            usage: wgpu::BufferUsages::INDEX,
-        });
-    (vb, ib, idx.len() as u32)
 }

@@ -29,8 +29,9 @@ pub fn parse_themes(path: &Path, text: &str) -> Result<ThemeSpec> {
     Ok(spec)
 }
 
-/// Load the theme set at `path`. `heightmap` serves a `Rules` map that names none (a
-/// pipeline's `Themes` stage passes the pipeline's height map).
+/// Load the theme set at `path`. `heightmap`, when given, is the height map a `Rules` map
+/// classifies, in place of the one the file names: a pipeline's `Themes` stage passes the
+/// pipeline's, so that the classes follow the baked relief texel for texel.
 pub fn load_themes(path: &Path, heightmap: Option<&HeightMap>) -> Result<ThemeSet> {
     let text = std::fs::read_to_string(path).at(path, "cannot read theme set")?;
     let spec = parse_themes(path, &text)?;
@@ -91,11 +92,11 @@ fn index_map_of(
         } => {
             let loaded;
             let map = match (heightmap, given) {
-                (Some(file), _) => {
+                (_, Some(m)) => m,
+                (Some(file), None) => {
                     loaded = crate::load::heightmap_input(&dir.join(file), None, None)?;
                     &loaded
                 }
-                (None, Some(m)) => m,
                 (None, None) => return Err(Error::input(
                     path,
                     "the `Rules` map names no `heightmap`: give one (a path relative to this file)",

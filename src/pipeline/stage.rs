@@ -2,8 +2,8 @@
 //! order. How a stage runs lives in `crate::bake::stages`.
 
 use super::knobs::{
-    EncodeKnobs, FormFactorsKnobs, HorizonMapsKnobs, MinmaxMipmapKnobs, ReorderKnobs,
-    ThemesKnobs, TransportKnobs, VoxelizeKnobs,
+    EncodeKnobs, FormFactorsKnobs, HorizonMapsKnobs, MinmaxMipmapKnobs, ReorderKnobs, ThemesKnobs,
+    TransportKnobs, VoxelizeKnobs,
 };
 use super::Pipeline;
 use crate::error::{Error, Result};

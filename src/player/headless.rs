@@ -64,6 +64,7 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
         let t0 = Instant::now();
         player.set_sun(gpu, sun)?;
         player.set_phase(f as f64 / (plan.frames.max(2) - 1) as f64);
+        player.set_frame(gpu, f, &plan.settings);
         player.render(gpu, &camera, &plan.settings, &mut timer)?;
         let cpu_ms = t0.elapsed().as_secs_f64() * 1e3;
         let gpu_ms = timer

@@ -135,6 +135,14 @@ impl Player {
         }
     }
 
+    /// Set the animation frame of a terrain's theme borders (still unless
+    /// `s.theme_animation`); other scenes have none.
+    pub fn set_frame(&mut self, gpu: &Gpu, frame: u32, s: &FrameSettings) {
+        if let Player::Terrain(t) = self {
+            t.set_theme_frame(gpu, if s.theme_animation { frame } else { 0 });
+        }
+    }
+
     /// How a terrain frame with settings `s` computes its shadows (None for other scenes).
     pub fn terrain_shadows(&self, s: &FrameSettings) -> Option<&'static str> {
         let Player::Terrain(t) = self else {
@@ -167,6 +175,7 @@ impl Player {
                 t.settings.soft = s.soft_shadows;
                 t.settings.horizon = s.horizon_shadows;
                 t.settings.fog = s.fog;
+                t.settings.themes = s.themes;
                 t.render(gpu, camera, timer)
             }
             Player::Freeform(f) => f.render(gpu, camera, s, timer),

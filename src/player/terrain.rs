@@ -1,7 +1,8 @@
 //! Height-map bakes at runtime: the height field as a mesh with per-pixel relief shadows (hard
 //! from the horizon maps when baked, else by the accelerated traversal over the min/max mipmap;
 //! or soft by branch-and-bound), shadow
-//! brightness k_shadow, aerial perspective; the sun moves freely.
+//! brightness k_shadow, thematic textures (animated borders) when baked, aerial perspective;
+//! the sun moves freely.
 
 use crate::baked::{self, Manifest};
 use crate::error::Result;
@@ -21,6 +22,8 @@ pub struct TerrainPlayer {
     pub mip: MinMaxMipmap,
     pub renderer: TerrainRenderer,
     pub settings: TerrainSettings,
+    /// The bake's theme set (`themes.bin`), when it has one.
+    pub themes: Option<crate::theme::ThemeSet>,
 }
 
 impl TerrainPlayer {
@@ -55,11 +58,19 @@ impl TerrainPlayer {
             let hm = baked::horizon::read(dir, manifest, (map.width, map.height), map.cell_size)?;
             renderer.set_horizon(gpu, hm)?;
         }
+        let themes = if manifest.file(baked::themes::FILE).is_some() {
+            let set = baked::themes::read(dir)?;
+            renderer.set_themes(gpu, &set);
+            Some(set)
+        } else {
+            None
+        };
         Ok(TerrainPlayer {
             map,
             mip,
             renderer,
             settings: TerrainSettings::default(),
+            themes,
         })
     }
 
@@ -86,6 +97,13 @@ impl TerrainPlayer {
         self.renderer
             .set_sun(gpu, Sun::new(s.azimuth_deg, s.elevation_deg)?);
         Ok(())
+    }
+
+    /// Move the theme borders to animation frame `frame` (0 = still).
+    pub fn set_theme_frame(&mut self, gpu: &Gpu, frame: u32) {
+        if let Some(set) = &self.themes {
+            self.renderer.set_theme_shift(gpu, set.shift(frame));
+        }
     }
 
     /// Record and submit one frame.

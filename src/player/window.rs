@@ -194,6 +194,7 @@ impl App {
             return Ok(false);
         };
         let t0 = Instant::now();
+        r.player.set_frame(&r.gpu, self.frames, &self.plan.settings);
         r.player
             .render(&r.gpu, &r.orbit.camera(), &self.plan.settings, &mut r.timer)?;
         let frame = match r.surface.get_current_texture() {
@@ -269,6 +270,8 @@ impl App {
                 "5" => self.plan.settings.soft_shadows = !self.plan.settings.soft_shadows,
                 "6" => self.plan.settings.fog = !self.plan.settings.fog,
                 "7" => self.plan.settings.horizon_shadows = !self.plan.settings.horizon_shadows,
+                "8" => self.plan.settings.themes = !self.plan.settings.themes,
+                "9" => self.plan.settings.theme_animation = !self.plan.settings.theme_animation,
                 "[" => self.plan.settings.exposure /= 1.25,
                 "]" => self.plan.settings.exposure *= 1.25,
                 _ => {}

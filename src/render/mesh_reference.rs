@@ -25,6 +25,10 @@ pub struct FrameSettings {
     pub horizon_shadows: bool,
     /// Terrain: aerial perspective.
     pub fog: bool,
+    /// Terrain: thematic textures when the bake has a theme set (else the hypsometric tint).
+    pub themes: bool,
+    /// Terrain: theme borders move from frame to frame.
+    pub theme_animation: bool,
     /// Display colour behind the scene (sRGB, 0..1).
     pub background: [f32; 3],
 }
@@ -41,6 +45,8 @@ impl Default for FrameSettings {
             soft_shadows: false,
             horizon_shadows: true,
             fog: true,
+            themes: true,
+            theme_animation: true,
             background: [0.0; 3],
         }
     }

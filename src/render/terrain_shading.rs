@@ -7,6 +7,7 @@ use super::tonemap::{to_u8, tonemap};
 use crate::heightmap::HeightMap;
 use crate::terrain::relief::{k_shadow, lambert};
 use crate::terrain::sun::Sun;
+use crate::theme::ThemeSet;
 use serde::{Deserialize, Serialize};
 
 /// Display knobs of a terrain frame.
@@ -24,6 +25,9 @@ pub struct TerrainSettings {
     /// Hard shadows from the horizon maps (O(1) per pixel, interpolated between stored
     /// azimuths) when the bake has them, instead of the traversal over the min/max mipmap.
     pub horizon: bool,
+    /// Thematic textures (docs/themes.md) instead of the hypsometric tint when the bake has a
+    /// theme set.
+    pub themes: bool,
     /// Aerial perspective (the function-based geometry paper's scattered light, docs/algorithms.md §6), per pixel.
     pub fog: bool,
     /// Extinction β_ext per metre.
@@ -47,6 +51,7 @@ impl Default for TerrainSettings {
             shadows: true,
             soft: false,
             horizon: true,
+            themes: true,
             fog: true,
             fog_extinction: 2.5e-6,
             fog_albedo: 0.6,
@@ -71,29 +76,51 @@ pub fn tint(t: f32) -> [f32; 3] {
     }
 }
 
-/// Radiance of a texel before fog: twin of `texel_radiance`.
-pub fn texel_radiance(s: &TerrainSettings, t: f32, lambert: f32, shadow: f32, k: f32) -> [f32; 3] {
+/// Radiance of a texel of `albedo` before fog: twin of `texel_radiance`.
+pub fn texel_radiance(
+    s: &TerrainSettings,
+    albedo: [f32; 3],
+    lambert: f32,
+    shadow: f32,
+    k: f32,
+) -> [f32; 3] {
     let relief = lambert * (1.0 - (1.0 - k) * shadow);
-    tint(t).map(|c| c * (s.sun_strength * relief + 0.15))
+    albedo.map(|c| c * (s.sun_strength * relief + 0.15))
 }
 
 /// The map view (one pixel per texel, north up, no fog) of `map` under `sun` with per-texel
-/// shadowed fraction `shadow` (1 = hard shadow).
+/// shadowed fraction `shadow` (1 = hard shadow), textured by `themes` when given (animation
+/// frame `frame`) and `s.themes`, else by the hypsometric tint.
 pub fn map_view(
     map: &HeightMap,
     sun: &Sun,
     shadow: &[f32],
     s: &TerrainSettings,
+    themes: Option<(&ThemeSet, u32)>,
 ) -> image::RgbaImage {
+    let lookup = themes.filter(|_| s.themes).map(|(t, f)| t.lookup(f));
     let lam = lambert(map, sun);
     let k = k_shadow(sun, s.k_dark as f64, s.k_bright as f64) as f32;
     let (lo, hi) = map.min_max();
     let span = (hi - lo).max(1e-6);
     let mut img = image::RgbaImage::new(map.width as u32, map.height as u32);
     for (i, px) in img.pixels_mut().enumerate() {
-        let t = (map.heights[i] - lo) / span;
         let sh = if s.shadows { shadow[i] } else { 0.0 };
-        let c = tonemap(texel_radiance(s, t, lam[i], sh, k), s.exposure);
+        let albedo = match &lookup {
+            Some(l) => {
+                // The index map spans the height map: texel centre → index texels.
+                let base = &l.set.index.levels[0];
+                let sx = base.width as f32 / map.width as f32;
+                let sy = base.height as f32 / map.height as f32;
+                let p = [
+                    ((i % map.width) as f32 + 0.5) * sx,
+                    ((i / map.width) as f32 + 0.5) * sy,
+                ];
+                l.albedo(p, sx.max(sy))
+            }
+            None => tint((map.heights[i] - lo) / span),
+        };
+        let c = tonemap(texel_radiance(s, albedo, lam[i], sh, k), s.exposure);
         *px = image::Rgba([to_u8(c[0]), to_u8(c[1]), to_u8(c[2]), 255]);
     }
     img

@@ -121,6 +121,28 @@ pub struct ThemeSet {
     pub drift: [f32; 2],
 }
 
+impl ThemeSet {
+    /// A one-texel, one-theme set: what a renderer binds before a bake's themes are set.
+    pub fn placeholder() -> ThemeSet {
+        let class = Class {
+            theme: 0,
+            border: Border::Natural,
+            tiling: Tiling::default(),
+        };
+        ThemeSet {
+            themes: vec!["none".into()],
+            classes: vec![class],
+            index: mip::IndexMips::build(index_map::IndexMap::filled(1, 1, 0)),
+            textures: textures::ThemeTextures::build(1, &[vec![[0.5; 3]]]),
+            noise: noise::TurbulenceMap {
+                size: 1,
+                values: vec![[0.0; 2]],
+            },
+            drift: [0.0; 2],
+        }
+    }
+}
+
 /// What a theme set costs against a global albedo texture (bytes).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Memory {

@@ -86,8 +86,9 @@ pub enum TextureSource {
 /// The index map's source.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum MapSpec {
-    /// Rules over a height map (`heightmap` relative to the theme file; in a pipeline's
-    /// `Themes` stage, omitted = the pipeline's height map). First matching rule wins.
+    /// Rules over a height map (`heightmap` relative to the theme file, or a height-map
+    /// pipeline; a pipeline's `Themes` stage uses the pipeline's height map instead). First
+    /// matching rule wins.
     Rules {
         #[serde(default)]
         heightmap: Option<String>,

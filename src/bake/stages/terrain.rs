@@ -127,14 +127,21 @@ impl StageRun for ThemesKnobs {
         let base = &set.index.levels[0];
         let m = set.memory();
         rec.report.insert("themes".into(), set.themes.len() as f64);
-        rec.report.insert("classes".into(), set.classes.len() as f64);
+        rec.report
+            .insert("classes".into(), set.classes.len() as f64);
         rec.report.insert("index_width".into(), base.width as f64);
         rec.report.insert("index_height".into(), base.height as f64);
-        rec.report.insert("index_levels".into(), set.index.levels.len() as f64);
-        rec.report.insert("bytes_index_ccc".into(), m.index_ccc as f64);
-        rec.report.insert("bytes_index_raw".into(), m.index_raw as f64);
+        rec.report
+            .insert("index_levels".into(), set.index.levels.len() as f64);
+        rec.report
+            .insert("bytes_index_ccc".into(), m.index_ccc as f64);
+        rec.report
+            .insert("bytes_index_raw".into(), m.index_raw as f64);
         rec.report.insert("bytes_total".into(), m.total as f64);
-        rec.report.insert("bytes_global_rgb8_index_res".into(), m.global_rgb8_index_res as f64);
+        rec.report.insert(
+            "bytes_global_rgb8_index_res".into(),
+            m.global_rgb8_index_res as f64,
+        );
         rec.facts.insert(
             "layout".into(),
             "themes.bin: RLTHEME1, u32 header length, JSON header, level-0 index map as CCC words \
