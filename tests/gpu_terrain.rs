@@ -117,8 +117,13 @@ fn map_view_difference(
     map: &HeightMap,
     sun: Sun,
     shadow: impl Fn(&TerrainRenderer) -> Vec<bool>,
+    themes: Option<(&relume::theme::ThemeSet, u32)>,
 ) -> (f64, u8) {
     r.set_sun(gpu, sun);
+    if let Some((set, frame)) = themes {
+        r.set_themes(gpu, set);
+        r.set_theme_shift(gpu, set.shift(frame));
+    }
     let s = TerrainSettings {
         fog: false,
         vertical_exaggeration: 1.0,
@@ -131,7 +136,7 @@ fn map_view_difference(
     gpu.queue.submit([enc.finish()]);
     let img = r.target.read_image(gpu).unwrap();
     let shadow: Vec<f32> = shadow(r).iter().map(|&b| b as u8 as f32).collect();
-    let want = map_view(map, &sun, &shadow, &s, None);
+    let want = map_view(map, &sun, &shadow, &s, themes);
     let (w, h) = (map.width as u32, map.height as u32);
     let (mut sum, mut n, mut worst) = (0u64, 0u64, 0u8);
     for y in 1..h - 1 {
@@ -156,12 +161,44 @@ fn map_view_matches_the_cpu_shading() {
     let (w, h) = (map.width as u32, map.height as u32);
     let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
     let sun = Sun::new(300.0, 12.0).unwrap();
-    let (mean, worst) = map_view_difference(&gpu, &mut r, &map, sun, |r| {
-        r.shadow_mask(&gpu, true).unwrap()
-    });
+    let (mean, worst) = map_view_difference(
+        &gpu,
+        &mut r,
+        &map,
+        sun,
+        |r| r.shadow_mask(&gpu, true).unwrap(),
+        None,
+    );
     eprintln!("terrain map view: mean |GPU − CPU| = {mean:.4}/255, max {worst}/255");
     // Same formulas in f32 on both sides; the GPU's pow/exp differ by ulps, so 8-bit values may
     // differ by one step at rounding boundaries.
+    assert!(worst <= 1, "max difference {worst}/255");
+    assert!(mean < 0.05, "mean difference {mean}");
+}
+
+#[test]
+fn themed_map_view_matches_the_cpu_shading() {
+    // The bundled Puget Sound themes over their height map, animation frame 3: the terrain
+    // frame's theme lookup (theme.wgsl, footprint from screen derivatives) against
+    // render::terrain_shading::map_view with theme::compose.
+    let Some(gpu) = gpu() else { return };
+    let map = puget_512();
+    let set =
+        relume::load::themes::load_themes(&common::data("themes/puget-sound.ron"), Some(&map))
+            .unwrap();
+    let mip = MinMaxMipmap::build(&map);
+    let (w, h) = (map.width as u32, map.height as u32);
+    let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
+    let sun = Sun::new(300.0, 12.0).unwrap();
+    let (mean, worst) = map_view_difference(
+        &gpu,
+        &mut r,
+        &map,
+        sun,
+        |r| r.shadow_mask(&gpu, true).unwrap(),
+        Some((&set, 3)),
+    );
+    eprintln!("themed map view: mean |GPU − CPU| = {mean:.4}/255, max {worst}/255");
     assert!(worst <= 1, "max difference {worst}/255");
     assert!(mean < 0.05, "mean difference {mean}");
 }
@@ -380,7 +417,8 @@ fn map_view_with_horizon_shadows_matches_the_cpu_shading() {
         "horizon shadows are the default when a bake has them"
     );
     let sun = Sun::new(205.0, 9.0).unwrap();
-    let (mean, worst) = map_view_difference(&gpu, &mut r, &map, sun, |_| hm.shadow_mask_f32(&sun));
+    let (mean, worst) =
+        map_view_difference(&gpu, &mut r, &map, sun, |_| hm.shadow_mask_f32(&sun), None);
     eprintln!("terrain map view with horizon shadows: mean {mean:.4}/255, max {worst}/255");
     // As in the traversal's map view: one 8-bit step at rounding boundaries.
     assert!(worst <= 1, "max difference {worst}/255");
