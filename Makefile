@@ -75,6 +75,7 @@ docs-images: build
 	$(BAKE) -q run pipelines/cornell.ron --out $(DOCS_OUT)/cornell
 	$(BAKE) -q run pipelines/gltf-room.ron --out $(DOCS_OUT)/gltf-room
 	$(BAKE) -q run pipelines/puget-sound-2k.ron --out $(DOCS_OUT)/puget-sound-2k
+	$(BAKE) -q theme themes/puget-sound.ron --size 480 --out docs/images/themes-puget-sound.png
 	$(BAKE) -q run pipelines/furnished-room.ron --out $(DOCS_OUT)/furnished-room
 	$(PLAYER) $(DOCS_OUT)/furnished-room --headless -q --size 640x400 --exposure 2.5 \
 	    --camera 8.7,1.75,0.4,3.2,0.8,3.0,70 --out $(DOCS_OUT)/furnished-room-frames

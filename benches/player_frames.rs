@@ -4,7 +4,8 @@
 //! times are CPU times of a software rasteriser, not GPU times.
 //!
 //! The terrain frame is one render pass with the relief shadows traced per pixel inside it: the
-//! shadows' cost is the difference between the "shadows" and "no shadows" rows.
+//! shadows' cost is the difference between the "shadows" and "no shadows" rows; the thematic
+//! textures' cost the difference between the horizon-map rows with and without themes.
 //!
 //! `cargo bench --bench player_frames [-- --frames N]`
 
@@ -78,6 +79,7 @@ fn main() {
                 ("no shadows", Shadows::None),
                 ("hard shadows (traversal)", Shadows::Hard),
                 ("hard shadows (horizon maps, 64)", Shadows::Horizon),
+                ("horizon maps, hypsometric tint (no themes)", Shadows::Horizon),
                 ("soft shadows", Shadows::Soft),
             ],
         ),
@@ -120,6 +122,7 @@ fn main() {
                         shadows: *shadows != Shadows::None,
                         soft_shadows: *shadows == Shadows::Soft,
                         horizon_shadows: *shadows == Shadows::Horizon,
+                        themes: !label.contains("no themes"),
                         exposure: 2.0,
                         ..Default::default()
                     },
