@@ -79,7 +79,10 @@ fn main() {
                 ("no shadows", Shadows::None),
                 ("hard shadows (traversal)", Shadows::Hard),
                 ("hard shadows (horizon maps, 64)", Shadows::Horizon),
-                ("horizon maps, hypsometric tint (no themes)", Shadows::Horizon),
+                (
+                    "horizon maps, hypsometric tint (no themes)",
+                    Shadows::Horizon,
+                ),
                 ("soft shadows", Shadows::Soft),
             ],
         ),

@@ -144,11 +144,12 @@ fn theme_bilinear(t: u32, l: u32, st: vec2<f32>) -> vec3<f32> {
 }
 
 fn theme_trilinear(t: u32, lod_in: f32, st: vec2<f32>) -> vec3<f32> {
-    let lod = clamp(lod_in, 0.0, f32(theme.tex_levels - 1u));
+    let top = f32(theme.tex_levels - 1u);
+    let lod = clamp(lod_in, 0.0, top);
     let l0 = floor(lod);
     let f = lod - l0;
     let a = theme_bilinear(t, u32(l0), st);
-    if (f == 0.0) {
+    if (f == 0.0 || l0 >= top) {
         return a;
     }
     let b = theme_bilinear(t, u32(l0) + 1u, st);

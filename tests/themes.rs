@@ -385,3 +385,33 @@ fn procedural_theme_textures_tile_without_a_seam() {
         );
     }
 }
+
+#[test]
+fn themes_bin_round_trips_and_refuses_truncation() {
+    let set = set_of(
+        regions(64),
+        3,
+        Border::Fractal {
+            amplitude: 2.0,
+            scale: 8.0,
+        },
+        Tiling::default(),
+        Procedural::Sand,
+    );
+    let bytes = relume::baked::themes::encode(&set);
+    let back = relume::baked::themes::decode(&bytes).unwrap();
+    assert_eq!(back.index, set.index);
+    assert_eq!(back.classes, set.classes);
+    assert_eq!(back.textures, set.textures);
+    assert_eq!(back.noise, set.noise);
+    assert_eq!((back.themes, back.drift), (set.themes.clone(), set.drift));
+    for cut in [0, 11, 40, bytes.len() / 2, bytes.len() - 1] {
+        assert!(
+            relume::baked::themes::decode(&bytes[..cut]).is_err(),
+            "cut at {cut}"
+        );
+    }
+    let mut longer = bytes.clone();
+    longer.push(0);
+    assert!(relume::baked::themes::decode(&longer).is_err());
+}

@@ -104,8 +104,16 @@ pub fn text(data: &[u8]) {
         1 => {
             let _ = relume::baked::Manifest::from_ron(path, text);
         }
-        _ => freeform(path, text),
+        _ => {
+            freeform(path, text);
+            themes(path, text);
+        }
     }
+}
+
+/// A theme set: parsed and checked (`relume-bake theme` before it reads any file).
+fn themes(path: &Path, text: &str) {
+    drop(relume::load::themes::parse_themes(path, text));
 }
 
 /// A freeform scene: parsed and checked, compiled (shape textures included), uploaded for the
@@ -209,10 +217,21 @@ pub fn baked(data: &[u8]) {
                 }
             }
         }
-        6 => drop(baked::permutation::read_file(&file(
-            baked::permutation::FILE,
-            rest,
-        ))),
+        6 => {
+            drop(baked::permutation::read_file(&file(
+                baked::permutation::FILE,
+                rest,
+            )));
+            // A theme set: decoded, then looked up as the player's twin does.
+            if let Ok(set) = baked::themes::decode(rest) {
+                let look = set.lookup(3);
+                for p in [[0.5f32, 0.5], [-3.0, 1e6], [17.25, 2.5]] {
+                    for footprint in [0.5f32, 1.0, 1e9] {
+                        drop(look.albedo(p, footprint));
+                    }
+                }
+            }
+        }
         7 => drop(baked::mipmap::read_file(&file(baked::mipmap::FILE, rest))),
         8 => drop(containers::parse_dds(Path::new("t.dds"), rest, enc)),
         _ => {

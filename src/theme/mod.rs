@@ -86,6 +86,21 @@ pub struct Tiling {
     pub warp_scale: f32,
 }
 
+impl Tiling {
+    /// Check the numbers (tile > 0, warp ≥ 0, warp_scale > 0, all finite).
+    pub fn check(&self) -> Result<(), String> {
+        let pos = |v: f32| v.is_finite() && v > 0.0;
+        if pos(self.tile) && pos(self.warp_scale) && self.warp.is_finite() && self.warp >= 0.0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "tiling needs tile > 0, warp ≥ 0 and warp_scale > 0 (got {}, {}, {})",
+                self.tile, self.warp, self.warp_scale
+            ))
+        }
+    }
+}
+
 impl Default for Tiling {
     fn default() -> Self {
         Tiling {

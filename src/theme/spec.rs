@@ -148,10 +148,6 @@ pub enum Coordinates {
     Unit,
 }
 
-fn finite_pos(v: f32) -> bool {
-    v.is_finite() && v > 0.0
-}
-
 impl ThemeSpec {
     /// Check everything that does not need a file; the message names the field.
     pub fn check(&self) -> Result<(), String> {
@@ -171,15 +167,9 @@ impl ThemeSpec {
             t.border
                 .check()
                 .map_err(|m| format!("theme `{}`: {m}", t.name))?;
-            let g = t.tiling;
-            if !(finite_pos(g.tile) && finite_pos(g.warp_scale) && g.warp.is_finite())
-                || g.warp < 0.0
-            {
-                return Err(format!(
-                    "theme `{}`: tiling needs tile > 0, warp ≥ 0 and warp_scale > 0 (got {}, {}, {})",
-                    t.name, g.tile, g.warp, g.warp_scale
-                ));
-            }
+            t.tiling
+                .check()
+                .map_err(|m| format!("theme `{}`: {m}", t.name))?;
         }
         let s = self.texture_size;
         if !(s.is_power_of_two() && (4..=1024).contains(&s)) {

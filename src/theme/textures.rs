@@ -192,11 +192,16 @@ impl ThemeTextures {
     /// `theme_trilinear`.
     pub fn trilinear(&self, lut: &[f32; 256], theme: usize, lod: f32, s: f32, t: f32) -> [f32; 3] {
         let top = (self.levels - 1) as f32;
-        let lod = lod.clamp(0.0, top);
+        // NaN (from a degenerate footprint) reads level 0, as the GPU's clamp may.
+        let lod = if lod.is_nan() {
+            0.0
+        } else {
+            lod.clamp(0.0, top)
+        };
         let l0 = lod.floor();
         let f = lod - l0;
         let a = self.bilinear(lut, theme, l0 as usize, s, t);
-        if f == 0.0 {
+        if f == 0.0 || l0 >= top {
             return a;
         }
         let b = self.bilinear(lut, theme, l0 as usize + 1, s, t);
