@@ -70,7 +70,7 @@ fn shared_structs() -> Vec<Shared> {
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
     use relume::gpu::themes::ThemeParams;
     vec![
-        shared!("atmosphere.wgsl", "AtmosphereParams", AtmosphereGpu {
+        shared!("atmosphere_common.wgsl", "AtmosphereParams", AtmosphereGpu {
             "rayleigh": field!(AtmosphereGpu, rayleigh),
             "mie_scattering": field!(AtmosphereGpu, mie_scattering),
             "mie_extinction": field!(AtmosphereGpu, mie_extinction),

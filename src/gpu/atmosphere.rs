@@ -1,11 +1,16 @@
 //! Hillaire's tables on the GPU (`shaders/atmosphere.wgsl`): the four build kernels, storage
-//! buffers of `vec4<f32>` texels (the layouts of `atmosphere::twin`), and a test kernel that
-//! evaluates the lookups a renderer calls. CPU twin: `atmosphere::lut::Luts::build`.
+//! buffers of `vec4<f32>` texels (the layouts of `atmosphere::twin`), and a test kernel
+//! (`shaders/atmosphere_kernel.wgsl`) that evaluates the lookups a renderer calls.
+//! CPU twin: `atmosphere::lut::Luts::build`.
 //!
-//! A render pass binds, in its own group, the uniform [`AtmosphereTables::params`] and the
-//! read-only storage buffers `transmittance`, `multi_scattering`, `sky_view`, `aerial`
-//! (bindings 0 to 4 of `atmosphere.wgsl`), and calls `sky_radiance(dir)` and
-//! `aerial_perspective(dir, distance_km)`.
+//! A render shader includes `atmosphere_lookup.wgsl` (`//! include atmosphere_lookup.wgsl`),
+//! which declares, in group 3: binding 0 the uniform [`AtmosphereTables::params`], binding 1
+//! the read-only storage `sky_view`, binding 2 the read-only storage `aerial`; it calls
+//! `sky_radiance(dir)` and `aerial_perspective(dir, distance_km)`. The pipeline's group 3
+//! layout comes from [`AtmosphereTables::layout_entries`] (or the shader, with an automatic
+//! layout) and its bind group from [`AtmosphereTables::bind_group`]. When the sun or the
+//! eye's altitude changes, [`AtmosphereTables::update`] rebuilds the two view-dependent
+//! tables (sky view, aerial volume) in place, so bind groups stay valid.
 
 use super::compute::{self, output, storage, uniform};
 use super::{readback, Gpu};
@@ -16,6 +21,9 @@ use crate::atmosphere::twin::{
 use crate::error::Result;
 
 const SHADER: &str = "atmosphere.wgsl";
+const KERNEL: &str = "atmosphere_kernel.wgsl";
+/// The group `atmosphere_lookup.wgsl` declares its bindings in.
+pub const LOOKUP_GROUP: u32 = 3;
 
 /// The tables of one eye altitude and sun, on the GPU.
 pub struct AtmosphereTables {
@@ -24,6 +32,10 @@ pub struct AtmosphereTables {
     pub multi_scattering: wgpu::Buffer,
     pub sky_view: wgpu::Buffer,
     pub aerial: wgpu::Buffer,
+    /// The parameters the tables were built for.
+    current: AtmosphereGpu,
+    /// Sky-view and aerial kernels with their bind groups, kept for [`Self::update`].
+    view_kernels: [(wgpu::ComputePipeline, wgpu::BindGroup, usize); 2],
 }
 
 fn texels(n: usize) -> u64 {
@@ -62,6 +74,16 @@ fn run(gpu: &Gpu, entry: &str, entries: &[(u32, &wgpu::Buffer)], invocations: us
     Ok(())
 }
 
+/// The parameters with the view-dependent ones (eye altitude, aerial range, sun) zeroed: two
+/// sets equal here share their transmittance and multiple-scattering tables.
+fn medium_only(p: &AtmosphereGpu) -> AtmosphereGpu {
+    let mut m = *p;
+    m.radii[2] = 0.0;
+    m.radii[3] = 0.0;
+    m.sun = [0.0; 4];
+    m
+}
+
 impl AtmosphereTables {
     /// Build the four tables for `params` (transmittance, then multiple scattering, then the
     /// sky view and the aerial-perspective volume).
@@ -70,47 +92,128 @@ impl AtmosphereTables {
         let [mw, mh] = MULTI_SCATTERING_SIZE;
         let [sw, sh] = SKY_VIEW_SIZE;
         let [ax, ay, az] = AERIAL_SIZE;
-        let t = AtmosphereTables {
-            params: uniform(gpu, "atmosphere params", params),
-            transmittance: output(gpu, "transmittance", texels(tw * th)),
-            multi_scattering: output(gpu, "multi scattering", texels(mw * mh)),
-            sky_view: output(gpu, "sky view", texels(sw * sh)),
-            aerial: output(gpu, "aerial perspective", texels(2 * ax * ay * az)),
+        let p = uniform(gpu, "atmosphere params", params);
+        let transmittance = output(gpu, "transmittance", texels(tw * th));
+        let multi_scattering = output(gpu, "multi scattering", texels(mw * mh));
+        let sky_view = output(gpu, "sky view", texels(sw * sh));
+        let aerial = output(gpu, "aerial perspective", texels(2 * ax * ay * az));
+        let read = [(0, &p), (1, &transmittance), (2, &multi_scattering)];
+        let kernel = |entry: &str, target: &wgpu::Buffer, n: usize| {
+            let pipeline = compute::pipeline(gpu, SHADER, entry)?;
+            let group = bind(gpu, &pipeline, &[read[0], read[1], read[2], (5, target)]);
+            Ok::<_, crate::error::Error>((pipeline, group, n))
         };
+        let view_kernels = [
+            kernel("build_sky_view", &sky_view, sw * sh)?,
+            kernel("build_aerial", &aerial, ax * ay * az)?,
+        ];
+        let t = AtmosphereTables {
+            params: p,
+            transmittance,
+            multi_scattering,
+            sky_view,
+            aerial,
+            current: *params,
+            view_kernels,
+        };
+        t.build_medium(gpu)?;
+        t.build_view_on(gpu);
+        Ok(t)
+    }
+
+    /// Transmittance, then multiple scattering (they depend on the medium only).
+    fn build_medium(&self, gpu: &Gpu) -> Result<()> {
+        let [tw, th] = TRANSMITTANCE_SIZE;
+        let [mw, mh] = MULTI_SCATTERING_SIZE;
         run(
             gpu,
             "build_transmittance",
-            &[(0, &t.params), (5, &t.transmittance)],
+            &[(0, &self.params), (5, &self.transmittance)],
             tw * th,
         )?;
         run(
             gpu,
             "build_multi_scattering",
             &[
-                (0, &t.params),
-                (1, &t.transmittance),
-                (5, &t.multi_scattering),
+                (0, &self.params),
+                (1, &self.transmittance),
+                (5, &self.multi_scattering),
             ],
             mw * mh,
-        )?;
-        let read = [
-            (0, &t.params),
-            (1, &t.transmittance),
-            (2, &t.multi_scattering),
-        ];
-        run(
-            gpu,
-            "build_sky_view",
-            &[read[0], read[1], read[2], (5, &t.sky_view)],
-            sw * sh,
-        )?;
-        run(
-            gpu,
-            "build_aerial",
-            &[read[0], read[1], read[2], (5, &t.aerial)],
-            ax * ay * az,
-        )?;
-        Ok(t)
+        )
+    }
+
+    /// The sky view and the aerial volume, with the kept pipelines.
+    fn build_view_on(&self, gpu: &Gpu) {
+        for (pipeline, group, n) in &self.view_kernels {
+            compute::dispatch(gpu, pipeline, group, [n.div_ceil(64) as u32, 1, 1]);
+        }
+    }
+
+    /// New parameters for the same buffers (bind groups made from them stay valid). When only
+    /// the eye's altitude, the aerial range or the sun differ from the last build, this
+    /// rebuilds just the sky view and the aerial volume (two dispatches, no pipeline
+    /// creation); otherwise all four tables.
+    pub fn update(&mut self, gpu: &Gpu, params: &AtmosphereGpu) -> Result<()> {
+        if *params == self.current {
+            return Ok(());
+        }
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(params));
+        if medium_only(params) != medium_only(&self.current) {
+            self.build_medium(gpu)?;
+        }
+        self.current = *params;
+        self.build_view_on(gpu);
+        Ok(())
+    }
+
+    /// The parameters the tables hold.
+    pub fn params_value(&self) -> &AtmosphereGpu {
+        &self.current
+    }
+
+    /// The group-3 layout entries of `atmosphere_lookup.wgsl`, visible to `visibility`.
+    pub fn layout_entries(visibility: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 3] {
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let ro = wgpu::BufferBindingType::Storage { read_only: true };
+        [
+            entry(0, wgpu::BufferBindingType::Uniform),
+            entry(1, ro),
+            entry(2, ro),
+        ]
+    }
+
+    /// A bind group for `layout` (group 3 of a pipeline whose shader includes
+    /// `atmosphere_lookup.wgsl`): the parameters, the sky view and the aerial volume.
+    pub fn bind_group(&self, gpu: &Gpu, layout: &wgpu::BindGroupLayout) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("atmosphere lookups"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.sky_view.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.aerial.as_entire_binding(),
+                },
+            ],
+        })
     }
 
     /// Read the tables back (to compare with `Luts::build`).
@@ -136,18 +239,23 @@ impl AtmosphereTables {
     pub fn evaluate(&self, gpu: &Gpu, queries: &[[f32; 4]]) -> Result<Vec<[f32; 4]>> {
         let q = storage(gpu, "atmosphere queries", queries);
         let out = output(gpu, "atmosphere evaluations", texels(4 * queries.len()));
-        run(
+        let pipeline = compute::pipeline(gpu, KERNEL, "evaluate")?;
+        let g0 = bind(gpu, &pipeline, &[(0, &out), (1, &q)]);
+        let empty = |i| {
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &pipeline.get_bind_group_layout(i),
+                entries: &[],
+            })
+        };
+        let (g1, g2) = (empty(1), empty(2));
+        let g3 = self.bind_group(gpu, &pipeline.get_bind_group_layout(LOOKUP_GROUP));
+        compute::dispatch_groups(
             gpu,
-            "evaluate",
-            &[
-                (0, &self.params),
-                (3, &self.sky_view),
-                (4, &self.aerial),
-                (5, &out),
-                (6, &q),
-            ],
-            queries.len(),
-        )?;
+            &pipeline,
+            &[(0, &g0), (1, &g1), (2, &g2), (LOOKUP_GROUP, &g3)],
+            [queries.len().div_ceil(64) as u32, 1, 1],
+        );
         let f = readback::read_f32(gpu, &out)?;
         Ok(f.chunks_exact(4)
             .take(4 * queries.len())

@@ -179,6 +179,9 @@ macro_rules! shaders {
 
 pub const SHADERS: &[(&str, &str)] = shaders![
     "atmosphere.wgsl",
+    "atmosphere_common.wgsl",
+    "atmosphere_kernel.wgsl",
+    "atmosphere_lookup.wgsl",
     "blit.wgsl",
     "common.wgsl",
     "corner_interpolate.wgsl",
@@ -209,24 +212,32 @@ fn raw_source(name: &str) -> Result<(&'static str, &'static str)> {
 }
 
 /// Full source of a kernel: `common.wgsl`, then every file named by a `//! include NAME` line
-/// (in order, each once), then the kernel itself.
+/// (in order, each once; an included file's own includes come before it, depth first), then
+/// the kernel itself.
 pub fn shader_source(name: &str) -> Result<String> {
     let (_, common) = raw_source("common.wgsl")?;
     if name == "common.wgsl" {
         return Ok(common.to_string());
     }
-    let (_, body) = raw_source(name)?;
+    let (kernel, body) = raw_source(name)?;
     let mut out = String::from(common);
-    let mut included = vec!["common.wgsl"];
+    let mut included = vec!["common.wgsl", kernel];
+    include_all(body, &mut included, &mut out)?;
+    out.push_str(&format!("\n// ---- {name}\n{body}"));
+    Ok(out)
+}
+
+/// Append the files `body` includes (and theirs, first) that are not in `included` yet.
+fn include_all(body: &str, included: &mut Vec<&'static str>, out: &mut String) -> Result<()> {
     for line in body.lines() {
         if let Some(inc) = line.trim().strip_prefix("//! include ") {
             let (inc_name, inc_body) = raw_source(inc.trim())?;
             if !included.contains(&inc_name) {
-                out.push_str(&format!("\n// ---- {inc_name}\n{inc_body}"));
                 included.push(inc_name);
+                include_all(inc_body, included, out)?;
+                out.push_str(&format!("\n// ---- {inc_name}\n{inc_body}"));
             }
         }
     }
-    out.push_str(&format!("\n// ---- {name}\n{body}"));
-    Ok(out)
+    Ok(())
 }
