@@ -1,21 +1,32 @@
 // Terrain frame: the height field as a grid mesh (x east = column · cell_x, y up = height,
-// z south = row · cell_y), shaded per pixel at the pixel's texel: hypsometric tint × (Lambert ×
-// shadow brightness + sky), relief shadows by the accelerated traversal or the horizon maps (hard), aerial
-// perspective, tone map; soft shadows (the sun disc's lit fraction by branch-and-bound) on
-// request. Rust twin: relume::render::terrain_shading.
+// z south = row · cell_y), shaded per pixel at the pixel's texel: albedo (thematic textures or
+// the hypsometric tint) × (sun × Lambert × shadow brightness + sky), relief shadows by the
+// accelerated traversal or the horizon maps (hard) or branch-and-bound (soft), scattered light
+// by the chosen atmosphere model, tone map; and the sky by the same model (`fs_sky`).
+// Rust twins: relume::render::terrain_shading, relume::theme::compose, relume::atmosphere.
 //! include terrain_shadow.wgsl
 //! include theme.wgsl
+//! include atmosphere_lookup.wgsl
 
 struct TerrainFrame {
     view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
     eye: vec4<f32>,            // world position (y up)
     sun: vec4<f32>,            // toward the sun in map space (x east, y north, z up); w = k_shadow
     cell: vec4<f32>,           // cell_x, cell_y, vertical exaggeration, grid step (texels)
-    fog: vec4<f32>,            // extinction per metre, scattering albedo, anisotropy g, sun strength
+    sun_light: vec4<f32>,      // sun irradiance reaching the terrain (RGB), w: sky (ambient) term
+    fog_ext: vec4<f32>,        // seed model: extinction per km (RGB), w: Mie g
+    fog_rayleigh: vec4<f32>,   // Rayleigh scattering per km (RGB), w: unused
+    fog_mie: vec4<f32>,        // Mie scattering per km (RGB), w: unused
+    fog_sun: vec4<f32>,        // sun illuminance lighting the air (RGB), w: radiance scale (π)
     exposure: f32,
-    flags: u32,                // bit 0 shadows, bit 1 fog, bit 2 soft shadows, bit 3 horizon maps, bit 4 themes
+    flags: u32,                // bit 0 shadows, bit 1 air, bit 2 soft shadows, bit 3 horizon maps, bit 4 themes
     min_height: f32,
     max_height_tint: f32,
+    model: u32,                // 1 seed fog per vertex, 2 per pixel, 3 Hillaire (with bit 1 set)
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 @group(0) @binding(0) var<uniform> frame: TerrainFrame;
 
@@ -23,6 +34,25 @@ struct VOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) texel: vec2<f32>,
     @location(1) world: vec3<f32>,
+    // Per-vertex seed fog: in-scattered radiance (rgb) and transmittance (rgb).
+    @location(2) fog_in: vec3<f32>,
+    @location(3) fog_t: vec3<f32>,
+}
+
+// Map space (x east, y north, z up) → world (x east, y up, z south).
+fn sun_world() -> vec3<f32> {
+    return vec3<f32>(frame.sun.x, frame.sun.z, -frame.sun.y);
+}
+
+// The seed's constant-density model over the segment eye → world: (in-scattered, transmittance)
+// in the terrain's radiance units (× frame.fog_sun.w).
+fn seed_fog(world: vec3<f32>) -> array<vec3<f32>, 2> {
+    let to_p = world - frame.eye.xyz;
+    let s_km = length(to_p) * 1e-3;
+    let mu = dot(to_p / max(length(to_p), 1e-6), sun_world());
+    let inscatter = fog(vec3<f32>(0.0), s_km, mu, frame.fog_ext.xyz, frame.fog_rayleigh.xyz,
+        frame.fog_mie.xyz, frame.fog_ext.w, frame.fog_sun.xyz) * frame.fog_sun.w;
+    return array<vec3<f32>, 2>(inscatter, exp(-frame.fog_ext.xyz * s_km));
 }
 
 @vertex
@@ -36,6 +66,13 @@ fn vs_main(@location(0) texel: vec2<f32>) -> VOut {
     o.clip = frame.view_proj * vec4<f32>(world, 1.0);
     o.texel = texel;
     o.world = world;
+    o.fog_in = vec3<f32>(0.0);
+    o.fog_t = vec3<f32>(1.0);
+    if ((frame.flags & 2u) != 0u && frame.model == 1u) {
+        let f = seed_fog(world);
+        o.fog_in = f[0];
+        o.fog_t = f[1];
+    }
     return o;
 }
 
@@ -74,17 +111,11 @@ fn tint(t_in: f32) -> vec3<f32> {
     return mix(mid, high, t * 2.0 - 1.0);
 }
 
-// Radiance of a texel (before fog): albedo × (sun × Lambert × (1 − (1 − k)·shadow) + sky).
+// Radiance of a texel (before the air): albedo × (sun × Lambert × (1 − (1 − k)·shadow) + sky).
 // Rust twin: relume::render::terrain_shading::texel_radiance.
 fn texel_radiance(albedo: vec3<f32>, lambert: f32, shadow: f32, k: f32) -> vec3<f32> {
     let relief = lambert * (1.0 - (1.0 - k) * shadow);
-    return albedo * (frame.fog.w * relief + 0.15);
-}
-
-// Henyey-Greenstein phase function.
-fn phase(cos_theta: f32, g: f32) -> f32 {
-    let d = 1.0 + g * g - 2.0 * g * cos_theta;
-    return (1.0 - g * g) / (4.0 * PI * pow(max(d, 1e-6), 1.5));
+    return albedo * (frame.sun_light.xyz * relief + frame.sun_light.w);
 }
 
 @fragment
@@ -114,16 +145,51 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
     }
     var rgb = texel_radiance(albedo, lambert_at(col, row), shadow, frame.sun.w);
     if ((frame.flags & 2u) != 0u) {
-        // Aerial perspective (docs/algorithms.md §6): L = L0·e^(−β s) + E_sun·(β_sc/β_ext)·Φ(θ)·(1 − e^(−β s)).
-        let to_eye = frame.eye.xyz - v.world;
-        let s = length(to_eye);
-        let view = -to_eye / max(s, 1e-6);
-        // Map space (x east, y north, z up) → world (x east, y up, z south).
-        let sun_world = vec3<f32>(frame.sun.x, frame.sun.z, -frame.sun.y);
-        let transmittance = exp(-frame.fog.x * s);
-        let inscatter = frame.fog.w * frame.fog.y * phase(dot(view, sun_world), frame.fog.z) * 4.0 * PI
-            * vec3<f32>(0.55, 0.65, 0.85);
-        rgb = rgb * transmittance + inscatter * (1.0 - transmittance);
+        // Scattered light (docs/atmosphere.md): L = L0·T + in-scattered.
+        if (frame.model == 1u) {
+            rgb = rgb * v.fog_t + v.fog_in;
+        } else if (frame.model == 2u) {
+            let f = seed_fog(v.world);
+            rgb = rgb * f[1] + f[0];
+        } else if (frame.model == 3u) {
+            let to_p = v.world - frame.eye.xyz;
+            let s = length(to_p);
+            let m = aerial_perspective(to_p / max(s, 1e-6), s * 1e-3);
+            rgb = rgb * m.transmittance + m.inscatter * frame.fog_sun.w;
+        }
+    }
+    return vec4<f32>(tonemap(rgb, frame.exposure), 1.0);
+}
+
+// The sky: a full-screen triangle at the far plane (drawn after the terrain, depth test
+// less-equal, so only where no terrain is), coloured by the atmosphere model.
+struct SkyOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) ndc: vec2<f32>,
+}
+
+@vertex
+fn vs_sky(@builtin(vertex_index) i: u32) -> SkyOut {
+    let xy = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u)) * 2.0 - vec2<f32>(1.0);
+    var o: SkyOut;
+    o.clip = vec4<f32>(xy, 1.0, 1.0);
+    o.ndc = xy;
+    return o;
+}
+
+@fragment
+fn fs_sky(v: SkyOut) -> @location(0) vec4<f32> {
+    let far = frame.inv_view_proj * vec4<f32>(v.ndc, 1.0, 1.0);
+    let near = frame.inv_view_proj * vec4<f32>(v.ndc, 0.0, 1.0);
+    let dir = normalize(far.xyz / far.w - near.xyz / near.w);
+    var rgb = vec3<f32>(0.0);
+    if (frame.model == 3u) {
+        rgb = sky_radiance(dir) * frame.fog_sun.w;
+    } else {
+        // The seed model's limit s → ∞: E_sun·(β_sc·Φ)/β_ext.
+        let mu = dot(dir, sun_world());
+        rgb = fog(vec3<f32>(0.0), 1e9, mu, frame.fog_ext.xyz, frame.fog_rayleigh.xyz,
+            frame.fog_mie.xyz, frame.fog_ext.w, frame.fog_sun.xyz) * frame.fog_sun.w;
     }
     return vec4<f32>(tonemap(rgb, frame.exposure), 1.0);
 }

@@ -125,14 +125,15 @@ fn map_view_difference(
         r.set_theme_shift(gpu, set.shift(frame));
     }
     let s = TerrainSettings {
-        fog: false,
+        atmosphere: relume::atmosphere::Model::None,
         vertical_exaggeration: 1.0,
         ..Default::default()
     };
     let (view_proj, eye) = r.map_view();
     let mut timer = PassTimer::new(gpu, 2);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    r.record(gpu, &mut enc, view_proj, eye, &s, &mut timer);
+    r.record(gpu, &mut enc, view_proj, eye, &s, &mut timer)
+        .unwrap();
     gpu.queue.submit([enc.finish()]);
     let img = r.target.read_image(gpu).unwrap();
     let shadow: Vec<f32> = shadow(r).iter().map(|&b| b as u8 as f32).collect();

@@ -15,6 +15,7 @@ pub mod mesh_renderer;
 pub mod radiosity_runtime;
 pub mod readback;
 pub mod render_target;
+pub mod terrain_air;
 mod terrain_buffers;
 pub mod terrain_renderer;
 pub mod themes;

@@ -4,6 +4,7 @@
 //! `render::terrain_shading`).
 
 use super::render_target::{RenderTarget, DEPTH_FORMAT, TARGET_FORMAT};
+use super::terrain_air::{air_frame, TerrainAir};
 use super::terrain_buffers::{grid_mesh, TerrainBuffers};
 use super::themes::ThemeGpu;
 use super::{compute, timing::PassTimer, Gpu};
@@ -55,14 +56,21 @@ pub struct TerrainParams {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TerrainFrame {
     pub view_proj: [f32; 16],
+    pub inv_view_proj: [f32; 16],
     pub eye: [f32; 4],
     pub sun: [f32; 4],
     pub cell: [f32; 4],
-    pub fog: [f32; 4],
+    pub sun_light: [f32; 4],
+    pub fog_ext: [f32; 4],
+    pub fog_rayleigh: [f32; 4],
+    pub fog_mie: [f32; 4],
+    pub fog_sun: [f32; 4],
     pub exposure: f32,
     pub flags: u32,
     pub min_height: f32,
     pub max_height_tint: f32,
+    pub model: u32,
+    pub pad: [u32; 3],
 }
 
 /// The horizon maps on the GPU: all planes stay on the CPU; the two around the sun's azimuth
@@ -100,6 +108,8 @@ pub struct TerrainRenderer {
     themes: ThemeGpu,
     theme_group: wgpu::BindGroup,
     has_themes: bool,
+    /// The air: Hillaire's tables and the sky pass.
+    air: TerrainAir,
 }
 
 /// Most grid vertices along a side of the display mesh (the shading is per texel regardless).
@@ -229,6 +239,7 @@ impl TerrainRenderer {
             g0,
             terrain_entries(&render_pipeline.get_bind_group_layout(1)),
         ];
+        let air = TerrainAir::new(gpu, &module, &render_pipeline, &frame);
         let themes = ThemeGpu::upload(gpu, &crate::theme::ThemeSet::placeholder());
         let theme_group = themes.bind(gpu, &render_pipeline.get_bind_group_layout(2));
 
@@ -261,6 +272,7 @@ impl TerrainRenderer {
             themes,
             theme_group,
             has_themes: false,
+            air,
         };
         r.params_cpu.max_height = mip.max_height;
         r.params_cpu.min_height = mip.min_height;
@@ -422,21 +434,44 @@ impl TerrainRenderer {
         )
     }
 
-    /// Record the terrain frame for `view_proj` seen from `eye`.
+    /// Record the terrain frame for `view_proj` seen from `eye` (and the sky by the same
+    /// atmosphere model). Hillaire's tables are rebuilt first when the sun or the eye's
+    /// altitude moved.
     pub fn record(
-        &self,
+        &mut self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
         view_proj: Mat4,
         eye: Vec3,
         s: &TerrainSettings,
         timer: &mut PassTimer,
-    ) {
+    ) -> Result<()> {
+        use crate::atmosphere::Model;
         let dir = self.sun.direction();
         let k =
             crate::terrain::relief::k_shadow(&self.sun, s.k_dark as f64, s.k_bright as f64) as f32;
+        // True altitudes (the display exaggerates heights).
+        let exaggeration = s.vertical_exaggeration.max(1e-6) as f64;
+        let eye_altitude = (eye.y as f64 / exaggeration).max(1.0);
+        let ground = 0.5 * (self.heights_range.0 + self.heights_range.1) as f64;
+        let air = air_frame(
+            &self.air.atmosphere,
+            s.atmosphere,
+            &self.sun,
+            eye_altitude,
+            ground.max(0.0),
+            s.sun_strength,
+        );
+        if s.atmosphere == Model::Hillaire {
+            let extent = (self.map_size.0 as f64 * self.cell[0] as f64)
+                .hypot(self.map_size.1 as f64 * self.cell[1] as f64);
+            let range = (2.0 * extent).max(50_000.0);
+            self.air
+                .prepare_tables(gpu, &self.render_pipeline, &self.sun, eye_altitude, range)?;
+        }
         let f = TerrainFrame {
             view_proj: view_proj.to_cols_array(),
+            inv_view_proj: view_proj.inverse().to_cols_array(),
             eye: eye.extend(1.0).to_array(),
             sun: [dir[0] as f32, dir[1] as f32, dir[2] as f32, k],
             cell: [
@@ -445,20 +480,21 @@ impl TerrainRenderer {
                 s.vertical_exaggeration,
                 self.grid_step as f32,
             ],
-            fog: [
-                s.fog_extinction,
-                s.fog_albedo,
-                s.fog_anisotropy,
-                s.sun_strength,
-            ],
+            sun_light: air.sun_light,
+            fog_ext: air.fog_ext,
+            fog_rayleigh: air.fog_rayleigh,
+            fog_mie: air.fog_mie,
+            fog_sun: air.fog_sun,
             exposure: s.exposure,
             flags: s.shadows as u32
-                | (s.fog as u32) << 1
+                | ((s.atmosphere != Model::None) as u32) << 1
                 | (s.soft as u32) << 2
                 | ((s.horizon && self.horizon.is_some()) as u32) << 3
                 | ((s.themes && self.has_themes) as u32) << 4,
             min_height: self.heights_range.0,
             max_height_tint: self.heights_range.1,
+            model: air.model,
+            pad: [0; 3],
         };
         gpu.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
@@ -467,9 +503,14 @@ impl TerrainRenderer {
         pass.set_bind_group(0, &self.render_groups[0], &[]);
         pass.set_bind_group(1, &self.render_groups[1], &[]);
         pass.set_bind_group(2, &self.theme_group, &[]);
+        pass.set_bind_group(3, &self.air.terrain_group, &[]);
         pass.set_vertex_buffer(0, self.grid.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..1);
+        if s.atmosphere != Model::None {
+            self.air.record_sky(&mut pass);
+        }
+        Ok(())
     }
 
     /// Texture the terrain with `set` (its index map spans the whole height map) instead of

@@ -174,7 +174,11 @@ impl Player {
                 t.settings.shadows = s.shadows;
                 t.settings.soft = s.soft_shadows;
                 t.settings.horizon = s.horizon_shadows;
-                t.settings.fog = s.fog;
+                t.settings.atmosphere = if s.fog {
+                    s.atmosphere
+                } else {
+                    crate::atmosphere::Model::None
+                };
                 t.settings.themes = s.themes;
                 t.render(gpu, camera, timer)
             }

@@ -112,7 +112,7 @@ impl TerrainPlayer {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let vp = camera.view_projection(self.renderer.target.width, self.renderer.target.height);
         self.renderer
-            .record(gpu, &mut enc, vp, camera.eye, &self.settings, timer);
+            .record(gpu, &mut enc, vp, camera.eye, &self.settings, timer)?;
         timer.resolve(&mut enc);
         gpu.queue.submit([enc.finish()]);
         gpu.wait();

@@ -23,8 +23,10 @@ pub struct FrameSettings {
     /// Terrain: hard shadows from the bake's horizon maps when it has them (else the
     /// traversal over the min/max mipmap).
     pub horizon_shadows: bool,
-    /// Terrain: aerial perspective.
+    /// Terrain: aerial perspective and sky (by `atmosphere`).
     pub fog: bool,
+    /// Terrain: which atmosphere model draws them.
+    pub atmosphere: crate::atmosphere::Model,
     /// Terrain: thematic textures when the bake has a theme set (else the hypsometric tint).
     pub themes: bool,
     /// Terrain: theme borders move from frame to frame.
@@ -45,6 +47,7 @@ impl Default for FrameSettings {
             soft_shadows: false,
             horizon_shadows: true,
             fog: true,
+            atmosphere: crate::atmosphere::Model::Hillaire,
             themes: true,
             theme_animation: true,
             background: [0.0; 3],

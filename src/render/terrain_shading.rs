@@ -28,14 +28,9 @@ pub struct TerrainSettings {
     /// Thematic textures (docs/themes.md) instead of the hypsometric tint when the bake has a
     /// theme set.
     pub themes: bool,
-    /// Aerial perspective (the function-based geometry paper's scattered light, docs/algorithms.md §6), per pixel.
-    pub fog: bool,
-    /// Extinction β_ext per metre.
-    pub fog_extinction: f32,
-    /// Scattering albedo β_sc/β_ext.
-    pub fog_albedo: f32,
-    /// Henyey-Greenstein anisotropy g of the phase function.
-    pub fog_anisotropy: f32,
+    /// Scattered light on the terrain and in the sky (docs/atmosphere.md): the seed's fog per
+    /// vertex or per pixel, Hillaire's tables, or none.
+    pub atmosphere: crate::atmosphere::Model,
     /// Sun irradiance scale.
     pub sun_strength: f32,
     pub background: [f32; 3],
@@ -52,10 +47,7 @@ impl Default for TerrainSettings {
             soft: false,
             horizon: true,
             themes: true,
-            fog: true,
-            fog_extinction: 2.5e-6,
-            fog_albedo: 0.6,
-            fog_anisotropy: 0.3,
+            atmosphere: crate::atmosphere::Model::Hillaire,
             sun_strength: 1.0,
             background: [0.55, 0.65, 0.8],
         }
