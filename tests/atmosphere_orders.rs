@@ -7,8 +7,10 @@
 #![allow(clippy::needless_range_loop)]
 
 use relume::atmosphere::double::{double_scattering, Quadrature};
+use relume::atmosphere::lut::Luts;
 use relume::atmosphere::monte_carlo::{trace, McOptions};
-use relume::atmosphere::reference::ViewRay;
+use relume::atmosphere::reference::{self, ViewRay};
+use relume::atmosphere::twin::AtmosphereGpu;
 use relume::atmosphere::{direction, Atmosphere};
 
 #[test]
@@ -59,5 +61,60 @@ fn monte_carlo_order_two_matches_the_nested_quadrature() {
             );
             assert!(mc.order2[c] < mc.multiple[c]);
         }
+    }
+}
+
+/// Measurement, not an assertion (slow: 54 rays × 20,000 paths): Hillaire's march split into
+/// its single part (Ψ_ms zeroed) against the single-scattering quadrature, and its multiple
+/// part against the tracer's orders ≥ 2. Prints channels whose multiple part is off > 20 %.
+#[test]
+#[ignore]
+fn hillaire_single_and_multiple_parts() {
+    let atm = Atmosphere::earth();
+    for sun_el in [90.0, 60.0, 30.0] {
+        let sun = direction(sun_el, 0.0);
+        let p = AtmosphereGpu::new(&atm, 1500.0, sun, 128_000.0);
+        let luts = Luts::build(&p);
+        let mut z = luts.clone();
+        for v in &mut z.multi_scattering {
+            *v = [0.0; 4];
+        }
+        let (mut ws, mut wm) = (0.0f64, 0.0f64);
+        for el in [0.0, -5.0] {
+            for az in [0.0, 90.0, 180.0] {
+                for s in [1000.0, 10000.0, 100000.0] {
+                    let ray = ViewRay {
+                        eye_altitude: 1500.0,
+                        dir: direction(el, az),
+                        sun,
+                        length: Some(s),
+                    };
+                    let (_, s) = ray.start_and_length(&atm);
+                    let d = direction(el, az).as_vec3();
+                    let (full, _) = luts.march_segment(d, (s / 1000.0) as f32, 64);
+                    let (single, _) = z.march_segment(d, (s / 1000.0) as f32, 64);
+                    let ss = reference::single_scattering(&atm, &ray).inscatter;
+                    let mc = trace(
+                        &atm,
+                        &ray,
+                        &McOptions {
+                            paths: 20_000,
+                            ..McOptions::default()
+                        },
+                    );
+                    for c in 0..3 {
+                        let es = (single[c] as f64 - ss[c]).abs() / ss[c];
+                        let hm = (full[c] - single[c]) as f64;
+                        let em = (hm - mc.multiple[c]) / mc.multiple[c];
+                        ws = ws.max(es);
+                        wm = wm.max(em.abs());
+                        if em.abs() > 0.2 {
+                            eprintln!("sun {sun_el} el {el} az {az} s {s:.0} c{c}: single rel {es:.4}, multi H {hm:.3e} MC {:.3e} ± {:.1e} ({em:+.3})", mc.multiple[c], mc.multiple_se[c]);
+                        }
+                    }
+                }
+            }
+        }
+        eprintln!("sun {sun_el}: Hillaire single part vs quadrature max rel {ws:.4}; multiple part vs MC orders>=2 max rel {wm:.4}");
     }
 }
