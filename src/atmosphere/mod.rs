@@ -14,6 +14,7 @@
 //! `shaders/atmosphere.wgsl`, parameterisations, filtering), `lut.rs` (building the tables and
 //! the lookups a renderer calls), `study.rs` (error against sun elevation).
 
+pub mod double;
 pub mod fog;
 pub mod lut;
 pub mod monte_carlo;

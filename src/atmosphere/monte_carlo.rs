@@ -54,6 +54,11 @@ pub struct McResult {
     /// Orders two and up (including light the ground reflected).
     pub multiple: [f64; 3],
     pub multiple_se: [f64; 3],
+    /// Order two alone: the sun estimate at the second vertex when that vertex is in the air
+    /// (scattered twice, no ground) — part of `multiple`, tallied to check it against
+    /// `double::double_scattering`.
+    pub order2: [f64; 3],
+    pub order2_se: [f64; 3],
 }
 
 struct Rng(rand_pcg::Pcg64);
@@ -171,6 +176,7 @@ pub fn trace(atm: &Atmosphere, ray: &ViewRay, opts: &McOptions) -> McResult {
     };
     let majorant = 2.0 * atm.max_extinction().iter().cloned().fold(0.0, f64::max);
     let (mut s1, mut s2, mut m1, mut m2) = ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
+    let (mut o1, mut o2) = ([0.0; 3], [0.0; 3]);
     for _ in 0..opts.paths {
         let u = rng.uniform();
         let j = cdf.partition_point(|c| *c < u).min(nodes.len() - 1);
@@ -178,8 +184,10 @@ pub fn trace(atm: &Atmosphere, ray: &ViewRay, opts: &McOptions) -> McResult {
         let mut w: [f64; 3] = std::array::from_fn(|c| n.weight * n.transmittance[c] * total / q[j]);
         let x = eye + n.t * ray.dir;
         let (single, d) = sc.at(x, ray.dir, &mut w, 1.0, &mut rng);
-        let multiple = continue_path(&sc, x, d, w, majorant, &mut rng);
+        let (multiple, order2) = continue_path(&sc, x, d, w, majorant, &mut rng);
         for c in 0..3 {
+            o1[c] += order2[c];
+            o2[c] += order2[c] * order2[c];
             s1[c] += single[c];
             s2[c] += single[c] * single[c];
             m1[c] += multiple[c];
@@ -193,11 +201,14 @@ pub fn trace(atm: &Atmosphere, ray: &ViewRay, opts: &McOptions) -> McResult {
         out.single_se[c] = se(s1[c], s2[c]);
         out.multiple[c] = m1[c] / nf;
         out.multiple_se[c] = se(m1[c], m2[c]);
+        out.order2[c] = o1[c] / nf;
+        out.order2_se[c] = se(o1[c], o2[c]);
     }
     out
 }
 
-/// The orders ≥ 2 of a path that left vertex `x` along `d` with weight `w`.
+/// The orders ≥ 2 of a path that left vertex `x` along `d` with weight `w`, and its order 2
+/// alone (the sun estimate at the next vertex if that is in the air).
 fn continue_path(
     sc: &Scatter<'_>,
     mut x: DVec3,
@@ -205,9 +216,10 @@ fn continue_path(
     mut w: [f64; 3],
     majorant: f64,
     rng: &mut Rng,
-) -> [f64; 3] {
+) -> ([f64; 3], [f64; 3]) {
     let atm = sc.atm;
     let mut sum = [0.0; 3];
+    let mut order2 = [0.0; 3];
     // Russian roulette below a quarter of the weight the path started with.
     let floor = 0.25 * w.iter().cloned().fold(0.0, f64::max);
     for event in 0..sc.opts.max_events {
@@ -234,6 +246,9 @@ fn continue_path(
             let (nee, nd) = sc.at(x, d, &mut w, mean, rng);
             for c in 0..3 {
                 sum[c] += nee[c];
+            }
+            if event == 0 {
+                order2 = nee;
             }
             d = nd;
         } else if ground {
@@ -269,5 +284,5 @@ fn continue_path(
             }
         }
     }
-    sum
+    (sum, order2)
 }

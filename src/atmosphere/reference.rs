@@ -28,7 +28,7 @@ const GL_W: [f64; 4] = [
 ];
 
 /// The 8 nodes and weights of `[a, b]`.
-fn gauss(a: f64, b: f64) -> [(f64, f64); 8] {
+pub fn gauss(a: f64, b: f64) -> [(f64, f64); 8] {
     let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
     let mut out = [(0.0, 0.0); 8];
     for k in 0..4 {
@@ -188,6 +188,11 @@ pub struct Node {
 
 /// The quadrature nodes of the view segment and the segment's transmittance.
 pub fn view_nodes(atm: &Atmosphere, ray: &ViewRay) -> (Vec<Node>, [f64; 3]) {
+    view_nodes_scaled(atm, ray, 1.0)
+}
+
+/// [`view_nodes`] with panels `scale` times longer.
+pub fn view_nodes_scaled(atm: &Atmosphere, ray: &ViewRay, scale: f64) -> (Vec<Node>, [f64; 3]) {
     let (eye, length) = ray.start_and_length(atm);
     let d = ray.dir;
     let ends = panels(
@@ -196,7 +201,7 @@ pub fn view_nodes(atm: &Atmosphere, ray: &ViewRay) -> (Vec<Node>, [f64; 3]) {
         d,
         length,
         &shadow_breaks(atm, eye, d, ray.sun),
-        1.0,
+        scale,
     );
     let mut tau0 = [0.0; 3];
     let mut nodes = Vec::with_capacity(8 * ends.len());
@@ -219,14 +224,19 @@ pub fn view_nodes(atm: &Atmosphere, ray: &ViewRay) -> (Vec<Node>, [f64; 3]) {
 /// Single scattering along the view ray by quadrature (no multiple scattering, no ground
 /// reflection): `∫₀ˢ T(0,t)·Σₖ βₖ(t)·Φₖ(θ)·T_sun(t)·E dt`.
 pub fn single_scattering(atm: &Atmosphere, ray: &ViewRay) -> Segment {
+    single_scattering_scaled(atm, ray, 1.0)
+}
+
+/// [`single_scattering`] with every panel (view and sun rays) `scale` times longer.
+pub fn single_scattering_scaled(atm: &Atmosphere, ray: &ViewRay, scale: f64) -> Segment {
     let (eye, _) = ray.start_and_length(atm);
     let mu = ray.dir.dot(ray.sun);
-    let (nodes, transmittance) = view_nodes(atm, ray);
+    let (nodes, transmittance) = view_nodes_scaled(atm, ray, scale);
     let mut out = [0.0; 3];
     for n in &nodes {
         let x = eye + n.t * ray.dir;
         let m = atm.medium(atm.altitude(x));
-        let ts = sun_transmittance(atm, x, ray.sun);
+        let ts = sun_transmittance_scaled(atm, x, ray.sun, scale);
         let sp = m.scattering_phase(atm, mu);
         for c in 0..3 {
             out[c] += n.weight * n.transmittance[c] * sp[c] * ts[c] * atm.sun_illuminance[c];
