@@ -16,7 +16,8 @@ use std::path::PathBuf;
 const KEYS: &str = "\
 Window keys: mouse drag or arrows orbit, wheel or +/- zoom, J/L sun azimuth, I/K sun elevation,
 S sun on/off, 1 direct, 2 indirect, 3 shadows, 4 emission, 5 soft shadows, 6 fog, 7 terrain
-hard shadows from horizon maps / by traversal, 8 themes, 9 theme-border animation, [ ] exposure,
+hard shadows from horizon maps / by traversal, 8 themes, 9 theme-border animation, 0 next
+atmosphere model (fog per vertex, fog per pixel, Hillaire), [ ] exposure,
 Esc quit. Headless, frame K of --frames N shows the theme borders of animation frame K.";
 
 fn after_help() -> String {
@@ -82,9 +83,12 @@ struct Cli {
     /// horizon maps (which give them in O(1) per pixel, interpolated between stored azimuths)
     #[arg(long)]
     no_horizon: bool,
-    /// Terrain: no aerial perspective
+    /// Terrain: no aerial perspective and no sky (same as --atmosphere none)
     #[arg(long)]
     no_fog: bool,
+    /// Terrain: the atmosphere model of the aerial perspective and the sky (docs/atmosphere.md)
+    #[arg(long, value_enum, value_name = "MODEL", default_value_t = relume::atmosphere::Model::Hillaire)]
+    atmosphere: relume::atmosphere::Model,
     /// Terrain: the hypsometric tint instead of the bake's thematic textures
     #[arg(long)]
     no_themes: bool,
@@ -131,6 +135,7 @@ fn settings(cli: &Cli) -> FrameSettings {
         soft_shadows: cli.soft,
         horizon_shadows: !cli.no_horizon,
         fog: !cli.no_fog,
+        atmosphere: cli.atmosphere,
         themes: !cli.no_themes,
         theme_animation: !cli.no_theme_animation,
         ..Default::default()

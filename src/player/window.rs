@@ -272,6 +272,14 @@ impl App {
                 "7" => self.plan.settings.horizon_shadows = !self.plan.settings.horizon_shadows,
                 "8" => self.plan.settings.themes = !self.plan.settings.themes,
                 "9" => self.plan.settings.theme_animation = !self.plan.settings.theme_animation,
+                "0" => {
+                    use crate::atmosphere::Model;
+                    self.plan.settings.atmosphere = match self.plan.settings.atmosphere {
+                        Model::Fog => Model::FogPerPixel,
+                        Model::FogPerPixel => Model::Hillaire,
+                        Model::Hillaire | Model::None => Model::Fog,
+                    }
+                }
                 "[" => self.plan.settings.exposure /= 1.25,
                 "]" => self.plan.settings.exposure *= 1.25,
                 _ => {}
