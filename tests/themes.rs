@@ -147,16 +147,15 @@ fn raising_the_amplitude_moves_border_texels_only() {
         );
         let look = set.lookup(0);
         let mut moved = 0;
-        for i in 0..map.data.len() {
-            if look.class(centre(i, 128), 1.0) != map.data[i] {
+        for (i, (&raw, &d)) in map.data.iter().zip(&dist).enumerate() {
+            if look.class(centre(i, 128), 1.0) != raw {
                 moved += 1;
                 // The lookup moves by at most amplitude·√2 (|noise| ≤ 1 per axis); a texel
                 // changes only if a texel of another class lies within that reach (+ half a
                 // texel either side for the texel-centre distance).
                 assert!(
-                    dist[i] <= amplitude as f64 * 2f64.sqrt() + 1.0,
-                    "amplitude {amplitude}: texel {i} at {} texels from a border changed",
-                    dist[i]
+                    d <= amplitude as f64 * 2f64.sqrt() + 1.0,
+                    "amplitude {amplitude}: texel {i} at {d} texels from a border changed"
                 );
             }
         }

@@ -98,19 +98,22 @@ pub fn decode(bytes: &[u8]) -> std::result::Result<ThemeSet, String> {
     let [w, hgt] = h.index;
     let ok_size = (1..=65536).contains(&w) && (1..=65536).contains(&hgt);
     let ts = h.texture_size;
-    if !ok_size
-        || h.words != w.div_ceil(4) * hgt.div_ceil(4)
-        || !(ts.is_power_of_two() && ts <= 1024)
-        || h.texture_levels != ts.trailing_zeros() as usize + 1
-        || !(1..=4096).contains(&h.noise_size)
-        || !h.drift.iter().all(|d| d.is_finite())
-        || h.themes.is_empty()
-        || h.classes.is_empty()
-        || h.classes.len() > crate::theme::MAX_CLASSES
-        || h.classes
-            .iter()
-            .any(|c| c.theme as usize >= h.themes.len() || c.border.check().is_err())
-    {
+    let sizes_agree = ok_size
+        && h.words == w.div_ceil(4) * hgt.div_ceil(4)
+        && ts.is_power_of_two()
+        && ts <= 1024
+        && h.texture_levels == ts.trailing_zeros() as usize + 1
+        && (1..=4096).contains(&h.noise_size)
+        && h.drift.iter().all(|d| d.is_finite());
+    let classes_valid = !h.themes.is_empty()
+        && !h.classes.is_empty()
+        && h.classes.len() <= crate::theme::MAX_CLASSES
+        && h.classes.iter().all(|c| {
+            (c.theme as usize) < h.themes.len()
+                && c.border.check().is_ok()
+                && c.tiling.check().is_ok()
+        });
+    if !(sizes_agree && classes_valid) {
         return Err("the header's sizes or classes are inconsistent".into());
     }
     let per_theme: usize = (0..h.texture_levels).map(|l| (ts >> l).pow(2)).sum();

@@ -160,7 +160,7 @@ fn index_map_of(
                 Coordinates::Texels => [1.0, 1.0],
                 Coordinates::Unit => [size.0 as f64, size.1 as f64],
             };
-            let mut list: Vec<(String, Option<Border>, Vec<Vec<[f64; 2]>>)> = vec![];
+            let mut list: Vec<Feature> = vec![];
             if let Some(file) = geojson {
                 list.extend(read_geojson(&dir.join(file))?);
             }
