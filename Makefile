@@ -21,6 +21,10 @@ build:
 ## The main job on the bundled default: bake the Cornell box (voxelize → form factors → transport
 ## → reorder → encode) and Puget Sound (min/max mipmap, at 4K and 2K), compute terrain shadows on
 ## the CPU, and render headless frames of both with the player (Mesa lavapipe when no GPU).
+## A camera south of the Cascades' highest peak looking north over valleys, ridges and the Sound
+## (world metres: x east, y up with heights ×3, z south; EYE,TARGET,FOV).
+PUGET_CAMERA := 110000,16000,140000,120000,3000,84000,60
+
 demo: build
 	@mkdir -p out/demo
 	$(BAKE) run pipelines/cornell.ron --out out/demo/cornell
@@ -38,10 +42,16 @@ demo: build
 	$(PLAYER) out/demo/cornell --headless --exposure 2 --size 640x480 --out out/demo/cornell-frames
 	$(PLAYER) out/demo/cornell --headless --exposure 1 --size 640x480 --sun 20,30 --frames 4 \
 	    --out out/demo/cornell-sun-frames
+	$(PLAYER) out/demo/puget-sound-2k --headless --size 960x540 --sun 265,5 --exposure 2.5 \
+	    --camera $(PUGET_CAMERA) --out out/demo/puget-sound-low-sun-frames
+	$(PLAYER) out/demo/puget-sound-2k --headless --size 960x540 --sun 200,55 --exposure 1.2 \
+	    --camera $(PUGET_CAMERA) --out out/demo/puget-sound-high-sun-frames
 	$(PLAYER) out/demo/puget-sound-2k --headless --size 640x480 --sun 300,6 --frames 2 \
-	    --out out/demo/puget-sound-frames
+	    --camera $(PUGET_CAMERA) --exposure 2.5 --atmosphere fog --out out/demo/puget-sound-frames
 	$(PLAYER) out/demo/puget-sound-2k --headless --size 640x480 --sun 300,6 --soft \
-	    --out out/demo/puget-sound-soft-frames
+	    --camera $(PUGET_CAMERA) --exposure 2.5 --out out/demo/puget-sound-soft-frames
+	$(BAKE) theme themes/puget-sound.ron --heightmap pipelines/puget-sound-2k.ron --size 2048 \
+	    --out out/demo/puget-sound-themes.png
 	@mkdir -p out/demo/freeform
 	for s in scenes/freeform/*.ron; do \
 	    $(BAKE) freeform render $$s --size 640x480 --quiet \
@@ -60,8 +70,11 @@ demo: build
 	@echo "  puget-sound-lit.png, puget-sound-soft-relief.png  soft shadows (CPU, 4K, sun 300°/3°)"
 	@echo "  cornell-frames/frame_0000.png                  player: the Cornell box lit by its ceiling light"
 	@echo "  cornell-sun-frames/frame_000[0-3].png          player: plus a sun turning around it (20°, 110°, 200°, 290°)"
-	@echo "  puget-sound-frames/frame_000[0-1].png          player: Puget Sound 2K, hard relief shadows"
+	@echo "  puget-sound-low-sun-frames/frame_0000.png      player: Puget Sound 2K, themes, Hillaire sky, sun 265°/5°"
+	@echo "  puget-sound-high-sun-frames/frame_0000.png     player: the same view, sun 200°/55°"
+	@echo "  puget-sound-frames/frame_000[0-1].png          player: hard relief shadows, the seed's fog (sun turning)"
 	@echo "  puget-sound-soft-frames/frame_0000.png         player: Puget Sound 2K, soft shadows"
+	@echo "  puget-sound-themes.png                         the theme albedo at 2048² (relume-bake theme)"
 	@echo "  */frames.json                                  adapter and per-pass frame times"
 	@echo "  freeform/*.png                                 every bundled freeform scene (CPU multilevel caster),"
 	@echo "                                                 morph-grid-0.5.png and -1.png the morph halfway and done"
@@ -83,7 +96,8 @@ docs-images: build
 	$(PLAYER) $(DOCS_OUT)/cornell --headless -q --size 480x360 --sun 20,30 --frames 4 --out $(DOCS_OUT)/cornell-sun-frames
 	$(PLAYER) $(DOCS_OUT)/gltf-room --headless -q --size 480x360 --exposure 2 \
 	    --camera 1.8,1.9,2.6,0,0.3,0,45 --out $(DOCS_OUT)/gltf-room-frames
-	$(PLAYER) $(DOCS_OUT)/puget-sound-2k --headless -q --size 400x250 --sun 300,6 --out $(DOCS_OUT)/terrain-frames
+	$(PLAYER) $(DOCS_OUT)/puget-sound-2k --headless -q --size 480x270 --sun 265,5 --exposure 2.5 \
+	    --camera $(PUGET_CAMERA) --out $(DOCS_OUT)/terrain-frames
 	$(BAKE) -q shadow pipelines/puget-sound-512.ron --sun-azimuth 300 --sun-elevation 10 \
 	    --out docs/images/puget-sound-shadow.png --shaded docs/images/puget-sound-relief.png
 	$(BAKE) -q softshadow pipelines/puget-sound-512.ron --sun-azimuth 300 --sun-elevation 3 \
