@@ -414,3 +414,23 @@ fn themes_bin_round_trips_and_refuses_truncation() {
     longer.push(0);
     assert!(relume::baked::themes::decode(&longer).is_err());
 }
+
+#[test]
+fn theme_texels_encode_to_the_nearest_srgb_byte() {
+    let table = relume::theme::textures::srgb_table();
+    for k in 0..=10_000 {
+        let v = k as f32 / 10_000.0;
+        let e = relume::theme::textures::encode_srgb8(&table, v) as usize;
+        // Nearest in linear light among all 256 bytes (brute force)...
+        let best = (0..256)
+            .min_by(|&a, &b| (table[a] - v).abs().total_cmp(&(table[b] - v).abs()))
+            .unwrap();
+        assert!(
+            (table[e] - v).abs() <= (table[best] - v).abs(),
+            "v {v}: {e} vs {best}"
+        );
+        // ...and within one step of the player's sRGB encoder (which rounds in sRGB space).
+        let other = relume::render::tonemap::linear_to_srgb8(v) as i32;
+        assert!((e as i32 - other).abs() <= 1, "v {v}: {e} vs {other}");
+    }
+}

@@ -1,13 +1,13 @@
 //! Theme textures: one small tileable T×T texture per theme with its mip chain, stored as
 //! sRGB-encoded RGBA8 (what a GPU texture of a theme costs), decoded through a 256-entry table
-//! that the GPU twin uploads as is, so both decode identically. Filtering happens in linear
+//! that the GPU twin uploads as is, so both decode identically (and encoded by that table's
+//! inverse, [`encode_srgb8`]). Filtering happens in linear
 //! light and only within one theme (the class lookup picks the theme first).
 //!
 //! relume generates the bundled themes procedurally ([`Procedural`]) from periodic noise, so
 //! they tile without a seam; a user may give PNGs instead (resampled to T by the loader).
 
 use super::noise::{fractal, NoiseSettings};
-use crate::render::tonemap::linear_to_srgb8;
 use serde::{Deserialize, Serialize};
 
 /// The procedural theme textures relume can make.
@@ -44,6 +44,18 @@ pub fn srgb_table() -> [f32; 256] {
         };
         l as f32
     })
+}
+
+/// Linear → the sRGB byte whose decoded value ([`srgb_table`]) is nearest: the inverse of
+/// the decoding table itself, so a texel decodes to the closest value a byte can hold.
+pub fn encode_srgb8(table: &[f32; 256], v: f32) -> u8 {
+    let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+    let i = table.partition_point(|&t| t < v).min(255);
+    if i > 0 && (v - table[i - 1]) <= (table[i] - v) {
+        (i - 1) as u8
+    } else {
+        i as u8
+    }
 }
 
 fn lerp3(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
@@ -128,6 +140,7 @@ impl ThemeTextures {
     pub fn build(size: usize, themes: &[Vec<[f32; 3]>]) -> ThemeTextures {
         assert!(size.is_power_of_two(), "theme textures are 2^k texels wide");
         let levels = size.trailing_zeros() as usize + 1;
+        let table = srgb_table();
         let mut texels = Vec::new();
         for base in themes {
             assert_eq!(base.len(), size * size);
@@ -135,7 +148,7 @@ impl ThemeTextures {
             let mut s = size;
             loop {
                 texels.extend(level.iter().map(|c| {
-                    let [r, g, b] = c.map(linear_to_srgb8);
+                    let [r, g, b] = c.map(|v| encode_srgb8(&table, v));
                     [r, g, b, 255]
                 }));
                 if s == 1 {
