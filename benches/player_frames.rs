@@ -5,10 +5,13 @@
 //!
 //! The terrain frame is one render pass with the relief shadows traced per pixel inside it: the
 //! shadows' cost is the difference between the "shadows" and "no shadows" rows; the thematic
-//! textures' cost the difference between the horizon-map rows with and without themes.
+//! textures' cost the difference between the horizon-map rows with and without themes, each
+//! atmosphere model's the difference against "air: none" (rows without an "air:" label use
+//! Hillaire's, the default; its tables are rebuilt every frame here, as the sun turns).
 //!
 //! `cargo bench --bench player_frames [-- --frames N]`
 
+use relume::atmosphere::Model;
 use relume::bake::{run_pipeline, BakeOptions};
 use relume::gpu::Gpu;
 use relume::pipeline::knobs::HorizonMapsKnobs;
@@ -126,6 +129,16 @@ fn main() {
                         soft_shadows: *shadows == Shadows::Soft,
                         horizon_shadows: *shadows == Shadows::Horizon,
                         themes: !label.contains("no themes"),
+                        // The default is Hillaire's model.
+                        atmosphere: if label.ends_with("air: none") {
+                            Model::None
+                        } else if label.ends_with("per vertex") {
+                            Model::Fog
+                        } else if label.ends_with("per pixel") {
+                            Model::FogPerPixel
+                        } else {
+                            Model::Hillaire
+                        },
                         exposure: 2.0,
                         ..Default::default()
                     },
