@@ -195,3 +195,52 @@ fn bad_theme_sets_are_refused_with_the_file_and_the_problem() {
         assert!(!d.join("x.png").exists(), "{what}: wrote output");
     }
 }
+
+#[test]
+fn the_themes_stage_bakes_themes_bin_and_reruns_when_the_theme_file_changes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    expect_code(
+        &bake(
+            d,
+            &[
+                "generate", "cone", "--size", "32", "--out", "cone.exr", "-q",
+            ],
+        ),
+        0,
+    );
+    let themes = |drift: &str| {
+        format!(
+            r#"Themes(themes: {THEMES}, map: Rules(rules: [Rule(theme: "sand", height: (min: 4.0))], otherwise: "forest"), drift: {drift})"#
+        )
+    };
+    write(d, "t.ron", &themes("(0.01, 0.0)"));
+    write(
+        d,
+        "p.ron",
+        r#"Pipeline(input: HeightMap(path: "cone.exr"), output: "out", stages: [Themes(file: "t.ron")])"#,
+    );
+    expect_code(&bake(d, &["run", "p.ron", "-q"]), 0);
+    let first = std::fs::read(d.join("out/themes.bin")).unwrap();
+    let set = relume::baked::themes::read(&d.join("out")).unwrap();
+    // The rule over the cone (height N/4 = 8 m at the centre): sand where the cone rises above 4 m.
+    let hist = set.index.levels[0].histogram();
+    assert!(hist[2] > 0 && hist[1] > hist[2], "{hist:?}");
+    expect_code(&bake(d, &["inspect", "out"]), 0);
+    // Unchanged: nothing to do. The theme file edited: the stage runs again.
+    let o = bake(d, &["run", "p.ron"]);
+    assert!(expect_code(&o, 0).contains("up to date"));
+    write(d, "t.ron", &themes("(0.02, 0.0)"));
+    expect_code(&bake(d, &["run", "p.ron", "-q"]), 0);
+    let second = std::fs::read(d.join("out/themes.bin")).unwrap();
+    assert_ne!(first, second, "the edited theme file was not baked again");
+    // A missing theme set stops the bake before any work, naming the file; the bake stays.
+    write(
+        d,
+        "q.ron",
+        r#"Pipeline(input: HeightMap(path: "cone.exr"), output: "out", stages: [Themes(file: "gone.ron")])"#,
+    );
+    let err = expect_code(&bake(d, &["run", "q.ron"]), 4);
+    assert!(err.contains("gone.ron"), "{err}");
+    assert_eq!(std::fs::read(d.join("out/themes.bin")).unwrap(), second);
+}

@@ -95,6 +95,20 @@ pub struct StageTiming {
 /// Before each stage that runs (is not taken from the cache), the rest of the pipeline is
 /// planned again with the sizes measured so far (the real patch count after voxelize) and the
 /// plan's peak is checked against `opts.max_memory`.
+/// Read and check the files stages name (a `Themes` stage's theme set) before any work, so a
+/// missing or malformed one stops the bake before the input is loaded.
+fn check_stage_files(pipeline: &Pipeline) -> Result<()> {
+    for stage in &pipeline.stages {
+        if let crate::pipeline::Stage::Themes(k) = stage {
+            let text = std::fs::read_to_string(&k.file).map_err(|e| {
+                crate::error::Error::io(&k.file, "cannot read the Themes stage's theme set", e)
+            })?;
+            crate::load::themes::parse_themes(&k.file, &text)?;
+        }
+    }
+    Ok(())
+}
+
 pub fn run_pipeline(
     pipeline: &Pipeline,
     output: &Path,
@@ -107,6 +121,7 @@ pub fn run_pipeline(
         Sharding::Merge { dirs } => Some(shard::ShardSet::scan(dirs)?),
         _ => None,
     };
+    check_stage_files(pipeline)?;
     progress.begin("load", 0);
     let input = load_input(&pipeline.input)?;
     progress.finish();
