@@ -1,6 +1,8 @@
 // Shading of a freeform frame (after `freeform.wgsl` cast it): Lambert and Phong under the sun,
 // an ambient fraction, sun shadows from the shadow pass, the background where the ray missed,
-// exposure, sRGB. Rust twin: relume::render::freeform_shade::shade32.
+// exposure, sRGB; thematic textures over every surface when the scene has them (theme.wgsl,
+// group 2). Rust twins: relume::render::freeform_shade::{shade32, themed_albedo}.
+//! include theme.wgsl
 
 struct ShadeFrame {
     forward: vec4<f32>,    // xyz, tan_x
@@ -8,7 +10,9 @@ struct ShadeFrame {
     up: vec4<f32>,         // xyz, exposure
     sun: vec4<f32>,        // unit direction toward the sun, ambient
     background: vec4<f32>, // linear rgb, unused
-    size: vec4<u32>,       // width, height, shadows, unused
+    size: vec4<u32>,       // width, height, shadows, theme projection (0 none, 1 planar, 2 spherical)
+    eye: vec4<f32>,        // xyz eye (world), w: the angle one pixel spans
+    projection: vec4<f32>, // planar: min x, min z, max x, max z; spherical: centre xyz
 }
 
 @group(0) @binding(0) var<uniform> shade_frame: ShadeFrame;
@@ -25,6 +29,33 @@ fn pow32(x: f32) -> f32 {
     let x8 = x4 * x4;
     let x16 = x8 * x8;
     return x16 * x16;
+}
+
+// The theme albedo where the unit ray d meets a surface at distance t: twin of
+// relume::render::freeform_shade::themed_albedo.
+fn freeform_theme_albedo(d: vec3<f32>, t: f32) -> vec3<f32> {
+    let p = shade_frame.eye.xyz + d * t;
+    let iw = theme.index_size.x;
+    let ih = theme.index_size.y;
+    let c = shade_frame.projection;
+    var u: f32;
+    var v: f32;
+    var texel: f32;
+    if (shade_frame.size.w == 1u) {
+        let sx = c.z - c.x;
+        let sz = c.w - c.y;
+        u = (p.x - c.x) / sx;
+        v = (p.z - c.y) / sz;
+        texel = sx / iw;
+    } else {
+        let q = p - c.xyz;
+        let r = max(sqrt(dot(q, q)), 1e-20);
+        u = (atan2(q.z, q.x) + PI) / (2.0 * PI);
+        v = acos(clamp(q.y / r, -1.0, 1.0)) / PI;
+        texel = 2.0 * PI * r / iw;
+    }
+    let footprint = t * shade_frame.eye.w / max(texel, 1e-20);
+    return theme_albedo(vec2<f32>(u * iw, v * ih), footprint);
 }
 
 @compute @workgroup_size(8, 8)
@@ -49,7 +80,11 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         let refl = 2.0 * dot(n, l) * n - l;
         let spec = m.w * vis * pow32(max(-dot(refl, d), 0.0));
         let a = shade_frame.sun.w;
-        rgb = m.xyz * (a + (1.0 - a) * ndl * vis) + vec3<f32>(spec);
+        var albedo = m.xyz;
+        if (shade_frame.size.w != 0u) {
+            albedo = freeform_theme_albedo(d, hit.x);
+        }
+        rgb = albedo * (a + (1.0 - a) * ndl * vis) + vec3<f32>(spec);
     }
     let e = rgb * shade_frame.up.w;
     let c = vec3<f32>(linear_to_srgb(clamp(e.x, 0.0, 1.0)), linear_to_srgb(clamp(e.y, 0.0, 1.0)), linear_to_srgb(clamp(e.z, 0.0, 1.0)));

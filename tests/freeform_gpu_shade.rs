@@ -12,18 +12,25 @@ use relume::freeform::{Bound, Field, View};
 use relume::gpu::freeform_caster::{FreeformCaster, ShadowSun};
 use relume::gpu::freeform_shader::FreeformShader;
 use relume::gpu::render_target::RenderTarget;
-use relume::render::freeform_shade::{shade32, Shading};
-use relume::scene::freeform::FreeformScene;
-use std::path::Path;
+use relume::render::freeform_shade::{shade32, themed_albedo, Shading, ThemeView};
 
 #[test]
 fn gpu_shadows_and_shading_return_the_twins() {
     let Some(gpu) = common::gpu() else { return };
     let caster = FreeformCaster::new(&gpu).unwrap();
-    let shader = FreeformShader::new(&gpu).unwrap();
+    let mut shader = FreeformShader::new(&gpu).unwrap();
     let params = RmlrcParams::default();
-    for name in ["csg-holes.ron", "terrain-16.ron"] {
-        let scene = FreeformScene::load(&Path::new("scenes/freeform").join(name)).unwrap();
+    for name in ["csg-holes.ron", "terrain-16.ron", "planet-themes.ron"] {
+        let path = common::data("scenes/freeform").join(name);
+        let scene = relume::load::freeform_scene(&path).unwrap();
+        let themes = scene.themes.as_ref().map(|t| {
+            let file = path.parent().unwrap().join(&t.file);
+            let set = relume::load::themes::load_themes(&file, None).unwrap();
+            (set, t.projection.packed())
+        });
+        if let Some((set, projection)) = &themes {
+            shader.set_themes(&gpu, set, *projection, 4);
+        }
         let field = Field::compile(&scene.shape).unwrap();
         let (w, h) = (96u32, 72u32);
         let view = View::new(scene.camera.as_ref().unwrap(), w, h);
@@ -55,7 +62,23 @@ fn gpu_shadows_and_shading_return_the_twins() {
             shadows: true,
         };
         let target = RenderTarget::new_storage(&gpu, w, h);
-        shader.shade(&gpu, &run, &v32, &shading, &target.view);
+        let eye = view.eye.map(|v| v as f32);
+        shader.shade(
+            &gpu,
+            &run,
+            &v32,
+            eye,
+            &shading,
+            themes.is_some(),
+            &target.view,
+        );
+        let theme_view = themes.as_ref().map(|(set, (kind, projection))| ThemeView {
+            look: set.lookup(4),
+            kind: *kind,
+            projection: *projection,
+            eye,
+            pixel_angle: 2.0 * v32.tan_x / w as f32,
+        });
         let image = target.read_image(&gpu).unwrap();
         let back = caster.read(&gpu, &run, &v32, false).unwrap();
         let twin = cast32(&gf, &v32, params.top_level, params.refine, prune);
@@ -70,7 +93,12 @@ fn gpu_shadows_and_shading_return_the_twins() {
                 t.is_some_and(|(t, n)| shadow32(&gf, &v32, d, t, n, l, scale, params.refine));
             let material = t.map_or([0.0; 4], |(t, _)| {
                 let leaf = eval32(&gf, d.map(|c| c * (t / len))).1;
-                gf.leaves[leaf].material
+                let mut m = gf.leaves[leaf].material;
+                if let Some(tv) = &theme_view {
+                    let a = themed_albedo(tv, du, t);
+                    m[..3].copy_from_slice(&a);
+                }
+                m
             });
             let expect = shade32(*t, shadowed, du, material, &shading);
             if t.is_some() {
@@ -94,7 +122,10 @@ fn gpu_shadows_and_shading_return_the_twins() {
             "{name}: {hits} hits, {lit_shadowed} in shadow; shadow mask differs on {shadow_diff}; {colour_off} pixels off by more than 2/255, else worst {worst}/255; {} pixel and {} shadow rounds",
             back.pixel_rounds, back.shadow_rounds
         );
-        assert!(lit_shadowed > 0, "{name}: the scene casts shadows");
+        assert!(
+            lit_shadowed > 0 || themes.is_some(),
+            "{name}: the scene casts shadows"
+        );
         // Measured (96x72, lavapipe): 0 shadow-mask differences and 0 colours off on both
         // scenes (worst 0/255); allowed: 0.1 % of pixels each, for a driver whose roundings
         // flip a grazing shadow ray or a pixel's last bit of colour.
@@ -102,8 +133,12 @@ fn gpu_shadows_and_shading_return_the_twins() {
             shadow_diff * 1000 <= hits,
             "{name}: {shadow_diff} shadow differences"
         );
+        // With themes: measured 21 of 6,912 pixels (0.30 %) off by more than 2/255 — the
+        // spherical projection's atan2/acos differ by ulps between the twins and a lookup that
+        // close to a class border or an index-level switch takes the other side; allowed 1 %.
+        let allowed = if themes.is_some() { 10 } else { 1 };
         assert!(
-            colour_off * 1000 <= (w * h) as usize,
+            colour_off * 1000 <= (w * h) as usize * allowed,
             "{name}: {colour_off} colours off"
         );
     }
@@ -218,6 +253,9 @@ fn the_player_draws_shape_textures_and_morphs_them_over_frames() {
     // 0.003; bounds 1 % and 1/255 as for csg-holes. Frame 2 against morph 0: 1,277 pixels.
     for (scene, frames, frame, morph, off_pct, mean_max) in [
         ("scenes/freeform/planet.ron", 1, 0, 0.0, 5, 2.0),
+        // The same with the Puget Sound themes (spherical projection): 480x360 measured 7.5 %
+        // off against the plain planet's 6.6 % at that size, mean 2.38/255 against 2.32.
+        ("scenes/freeform/planet-themes.ron", 1, 0, 0.0, 5, 2.0),
         ("scenes/freeform/morph-grid.ron", 3, 0, 0.0, 1, 1.0),
         ("scenes/freeform/morph-grid.ron", 3, 2, 1.0, 1, 1.0),
     ] {

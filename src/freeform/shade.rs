@@ -74,6 +74,21 @@ pub fn primary(field: &Field, view: &View, method: &Method) -> (Vec<Option<f64>>
 
 /// Render a frame: primary rays, normals, shading and sun shadows.
 pub fn render(field: &Field, view: &View, method: &Method, light: &Lighting) -> Frame {
+    render_with(field, view, method, light, None)
+}
+
+/// The albedo of a hit from the unit ray and the distance along it, in place of the surface's
+/// colour (a scene's thematic textures).
+pub type Albedo<'a> = &'a (dyn Fn([f64; 3], f64) -> [f64; 3] + Sync);
+
+/// [`render`] with every surface's colour replaced by `albedo` when given.
+pub fn render_with(
+    field: &Field,
+    view: &View,
+    method: &Method,
+    light: &Lighting,
+    albedo: Option<Albedo>,
+) -> Frame {
     let (hits, stats) = primary(field, view, method);
     let w = view.width as usize;
     let scale = ((view.far * view.near).sqrt()).max(1e-12);
@@ -100,9 +115,9 @@ pub fn render(field: &Field, view: &View, method: &Method, light: &Lighting) -> 
             let refl: [f64; 3] = std::array::from_fn(|k| 2.0 * dot(n, l) * n[k] - l[k]);
             let spec = leaf.specular * vis * (-dot(refl, dir)).max(0.0).powi(32);
             let a = light.ambient;
-            let rgb = std::array::from_fn(|k| {
-                (leaf.color[k] * (a + (1.0 - a) * ndl * vis) + spec) as f32
-            });
+            let color = albedo.map_or(leaf.color, |f| f(dir, t));
+            let rgb =
+                std::array::from_fn(|k| (color[k] * (a + (1.0 - a) * ndl * vis) + spec) as f32);
             (rgb, n.map(|v| v as f32))
         })
         .collect();

@@ -4,6 +4,7 @@
 
 use super::compute;
 use super::freeform_caster::GpuCast;
+use super::themes::ThemeGpu;
 use super::Gpu;
 use crate::error::Result;
 use crate::freeform::twin::View32;
@@ -19,28 +20,75 @@ pub struct ShadeFrameU {
     pub sun: [f32; 4],
     pub background: [f32; 4],
     pub size: [u32; 4],
+    pub eye: [f32; 4],
+    pub projection: [f32; 4],
 }
 
 pub struct FreeformShader {
     pipeline: wgpu::ComputePipeline,
+    /// The scene's themes (a placeholder until [`FreeformShader::set_themes`]) and how they
+    /// are laid on it (kind 0 = none).
+    themes: ThemeGpu,
+    theme_group: wgpu::BindGroup,
+    empty_group: wgpu::BindGroup,
+    projection: (u32, [f32; 4]),
 }
 
 impl FreeformShader {
     pub fn new(gpu: &Gpu) -> Result<FreeformShader> {
+        let pipeline = compute::pipeline(gpu, "freeform_shade.wgsl", "shade")?;
+        let themes = ThemeGpu::upload(gpu, &crate::theme::ThemeSet::placeholder());
+        let theme_group = themes.bind(gpu, &pipeline.get_bind_group_layout(2));
+        let empty_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipeline.get_bind_group_layout(1),
+            entries: &[],
+        });
         Ok(FreeformShader {
-            pipeline: compute::pipeline(gpu, "freeform_shade.wgsl", "shade")?,
+            pipeline,
+            themes,
+            theme_group,
+            empty_group,
+            projection: (0, [0.0; 4]),
         })
     }
 
-    /// Shade `cast` (of `view`) into `target` (a storage-capable RGBA8 view of the view's size).
+    /// Texture every surface with `set`, laid on the scene by `projection` (kind 1 planar /
+    /// 2 spherical and its numbers, `ThemeProjection::packed`), animation frame `frame`.
+    pub fn set_themes(
+        &mut self,
+        gpu: &Gpu,
+        set: &crate::theme::ThemeSet,
+        projection: (u32, [f32; 4]),
+        frame: u32,
+    ) {
+        self.themes = ThemeGpu::upload(gpu, set);
+        self.themes.set_shift(gpu, set.shift(frame));
+        self.theme_group = self
+            .themes
+            .bind(gpu, &self.pipeline.get_bind_group_layout(2));
+        self.projection = projection;
+    }
+
+    /// Move the theme borders to `shift` (`ThemeSet::shift`).
+    pub fn set_theme_shift(&mut self, gpu: &Gpu, shift: [f32; 2]) {
+        self.themes.set_shift(gpu, shift);
+    }
+
+    /// Shade `cast` (of `view`, its eye at `eye`) into `target` (a storage-capable RGBA8 view
+    /// of the view's size); `themed` applies the themes set with [`Self::set_themes`].
+    #[allow(clippy::too_many_arguments)]
     pub fn shade(
         &self,
         gpu: &Gpu,
         cast: &GpuCast,
         view: &View32,
+        eye: [f32; 3],
         s: &Shading,
+        themed: bool,
         target: &wgpu::TextureView,
     ) {
+        let kind = if themed { self.projection.0 } else { 0 };
         let u = ShadeFrameU {
             forward: [
                 view.forward[0],
@@ -52,7 +100,9 @@ impl FreeformShader {
             up: [view.up[0], view.up[1], view.up[2], s.exposure],
             sun: [s.sun[0], s.sun[1], s.sun[2], s.ambient],
             background: [s.background[0], s.background[1], s.background[2], 0.0],
-            size: [view.width, view.height, u32::from(s.shadows), 0],
+            size: [view.width, view.height, u32::from(s.shadows), kind],
+            eye: [eye[0], eye[1], eye[2], 2.0 * view.tan_x / view.width as f32],
+            projection: self.projection.1,
         };
         let ub = compute::uniform(gpu, "freeform shade", &u);
         let group = compute::bind(
@@ -71,6 +121,8 @@ impl FreeformShader {
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &group, &[]);
+            pass.set_bind_group(1, &self.empty_group, &[]);
+            pass.set_bind_group(2, &self.theme_group, &[]);
             pass.dispatch_workgroups(view.width.div_ceil(8), view.height.div_ceil(8), 1);
         }
         gpu.queue.submit([enc.finish()]);

@@ -1,6 +1,7 @@
 //! Freeform scenes at runtime (`relume-player scenes/freeform/X.ron`): the scene's field cast on
 //! the GPU each frame by the multilevel caster (`gpu::freeform_caster`), sun shadows by the
 //! same search toward the sun, and the shading kernel (`gpu::freeform_shader`) into the target.
+//! Thematic textures over every surface when the scene names a theme set (docs/themes.md).
 //! The sun and the camera move freely; nothing is baked.
 
 use crate::error::{Error, Result};
@@ -37,6 +38,8 @@ pub struct FreeformPlayer {
     sun: Sun,
     params: RmlrcParams,
     morph: f64,
+    /// The scene's theme set, when it names one.
+    pub themes: Option<crate::theme::ThemeSet>,
 }
 
 impl FreeformPlayer {
@@ -50,9 +53,20 @@ impl FreeformPlayer {
             azimuth_deg: s.azimuth,
             elevation_deg: s.elevation,
         });
+        let mut shader = FreeformShader::new(gpu)?;
+        let themes = match &scene.themes {
+            Some(t) => {
+                let file = path.parent().unwrap_or(Path::new(".")).join(&t.file);
+                let set = crate::load::themes::load_themes(&file, None)?;
+                shader.set_themes(gpu, &set, t.projection.packed(), 0);
+                Some(set)
+            }
+            None => None,
+        };
         Ok(FreeformPlayer {
             caster: FreeformCaster::new(gpu)?,
-            shader: FreeformShader::new(gpu)?,
+            shader,
+            themes,
             target: RenderTarget::new_storage(gpu, width, height),
             scene,
             field,
@@ -87,6 +101,13 @@ impl FreeformPlayer {
     pub fn set_sun(&mut self, sun: Option<Sun>) {
         if let Some(s) = sun {
             self.sun = s;
+        }
+    }
+
+    /// Move the theme borders to animation frame `frame`.
+    pub fn set_theme_frame(&mut self, gpu: &Gpu, frame: u32) {
+        if let Some(set) = &self.themes {
+            self.shader.set_theme_shift(gpu, set.shift(frame));
         }
     }
 
@@ -136,8 +157,16 @@ impl FreeformPlayer {
             exposure: s.exposure,
             shadows: s.shadows,
         };
-        self.shader
-            .shade(gpu, &run, &v32, &shading, &self.target.view);
+        let eye = view.eye.map(|v| v as f32);
+        self.shader.shade(
+            gpu,
+            &run,
+            &v32,
+            eye,
+            &shading,
+            s.themes && self.themes.is_some(),
+            &self.target.view,
+        );
         Ok(())
     }
 

@@ -135,11 +135,14 @@ impl Player {
         }
     }
 
-    /// Set the animation frame of a terrain's theme borders (still unless
-    /// `s.theme_animation`); other scenes have none.
+    /// Set the animation frame of the theme borders of a terrain or freeform scene (still
+    /// unless `s.theme_animation`); mesh scenes have none.
     pub fn set_frame(&mut self, gpu: &Gpu, frame: u32, s: &FrameSettings) {
-        if let Player::Terrain(t) = self {
-            t.set_theme_frame(gpu, if s.theme_animation { frame } else { 0 });
+        let frame = if s.theme_animation { frame } else { 0 };
+        match self {
+            Player::Terrain(t) => t.set_theme_frame(gpu, frame),
+            Player::Freeform(f) => f.set_theme_frame(gpu, frame),
+            Player::Mesh(_) => {}
         }
     }
 

@@ -48,3 +48,35 @@ pub fn shade32(
     let c = rgb.map(|v| to_u8(linear_to_srgb((v * s.exposure).clamp(0.0, 1.0))));
     [c[0], c[1], c[2], 255]
 }
+
+/// Thematic textures on a freeform frame: the set's lookup, how it is laid on the scene
+/// (`SceneThemes::projection` packed: kind 1 planar / 2 spherical), the eye and the angle one
+/// pixel spans (2·tan_x / width).
+pub struct ThemeView<'a> {
+    pub look: crate::theme::compose::Lookup<'a>,
+    pub kind: u32,
+    pub projection: [f32; 4],
+    pub eye: [f32; 3],
+    pub pixel_angle: f32,
+}
+
+/// The theme albedo where the unit ray `d` from the eye meets a surface at distance `t`: twin
+/// of `freeform_theme_albedo` in `shaders/freeform_shade.wgsl`.
+pub fn themed_albedo(tv: &ThemeView, d: [f32; 3], t: f32) -> [f32; 3] {
+    let p: [f32; 3] = std::array::from_fn(|k| tv.eye[k] + d[k] * t);
+    let base = &tv.look.set.index.levels[0];
+    let (iw, ih) = (base.width as f32, base.height as f32);
+    let c = tv.projection;
+    let (u, v, texel) = if tv.kind == 1 {
+        let (sx, sz) = (c[2] - c[0], c[3] - c[1]);
+        ((p[0] - c[0]) / sx, (p[2] - c[1]) / sz, sx / iw)
+    } else {
+        let q = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let r = dot(q, q).sqrt().max(1e-20);
+        let u = (q[2].atan2(q[0]) + std::f32::consts::PI) / std::f32::consts::TAU;
+        let v = (q[1] / r).clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
+        (u, v, std::f32::consts::TAU * r / iw)
+    };
+    let footprint = t * tv.pixel_angle / texel.max(1e-20);
+    tv.look.albedo([u * iw, v * ih], footprint)
+}

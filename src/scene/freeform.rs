@@ -41,6 +41,69 @@ pub struct FreeformScene {
     /// Ambient fraction of the sun's light on shadowed or back-facing points, in [0, 1].
     #[serde(default = "default_ambient")]
     pub ambient: f64,
+    /// Thematic textures over every surface (replacing the surfaces' colours): a theme set
+    /// (docs/themes.md) and how its index map is laid on the scene.
+    #[serde(default)]
+    pub themes: Option<SceneThemes>,
+}
+
+/// A theme set laid over a freeform scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneThemes {
+    /// The theme set, relative to the scene file (its map must not need a height map: an
+    /// `Image` or `Polygons` map, or `Rules` naming one).
+    pub file: String,
+    pub projection: ThemeProjection,
+}
+
+/// How a point of a surface finds its place on the index map.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ThemeProjection {
+    /// Straight down (−y) onto the rectangle `min`..`max` of the xz plane: u along x, v along z.
+    Planar { min: [f64; 2], max: [f64; 2] },
+    /// Longitude and latitude around `centre` (y up), as a sphere carrier's shape texture maps
+    /// them (equirectangular): u = (atan2(z, x) + π)/2π, v = θ/π with θ from +y.
+    Spherical { centre: [f64; 3] },
+}
+
+impl ThemeProjection {
+    /// Check the numbers.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        match *self {
+            ThemeProjection::Planar { min, max } => {
+                if !(min.iter().chain(&max).all(|v| v.is_finite())
+                    && min[0] < max[0]
+                    && min[1] < max[1])
+                {
+                    return Err(format!(
+                        "themes: a planar projection needs finite min < max, got {min:?}..{max:?}"
+                    ));
+                }
+            }
+            ThemeProjection::Spherical { centre } if !centre.iter().all(|v| v.is_finite()) => {
+                return Err(format!(
+                    "themes: the sphere's centre must be finite, got {centre:?}"
+                ));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The f32 view the shaders use: (kind 1 planar / 2 spherical, four numbers).
+    pub fn packed(&self) -> (u32, [f32; 4]) {
+        match *self {
+            ThemeProjection::Planar { min, max } => (
+                1,
+                [min[0] as f32, min[1] as f32, max[0] as f32, max[1] as f32],
+            ),
+            ThemeProjection::Spherical { centre } => (
+                2,
+                [centre[0] as f32, centre[1] as f32, centre[2] as f32, 0.0],
+            ),
+        }
+    }
 }
 
 fn default_background() -> [f64; 3] {
@@ -220,6 +283,9 @@ impl FreeformScene {
     }
 
     fn check(&self) -> std::result::Result<(), String> {
+        if let Some(t) = &self.themes {
+            t.projection.check()?;
+        }
         let mut leaves = Vec::new();
         self.shape.surfaces(&mut leaves);
         self.shape.check_arity()?;

@@ -5,6 +5,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use relume::baked::images::{self, check_extension};
 use relume::error::exit;
 use relume::freeform::{self, Bound, Field, Lighting, Method, RmlrcParams, View};
+use relume::render::freeform_shade::{themed_albedo, ThemeView};
 use relume::render::tonemap::linear_to_srgb8;
 use relume::scene::freeform::FreeformCamera;
 use relume::{Error, Result};
@@ -197,8 +198,40 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
         background: scene.background,
         shadows: !a.no_shadows,
     };
+    // The scene's thematic textures, by the player's twin (render::freeform_shade).
+    let themes = match &scene.themes {
+        Some(t) => {
+            let file = a
+                .scene
+                .parent()
+                .unwrap_or(std::path::Path::new("."))
+                .join(&t.file);
+            Some((
+                relume::load::themes::load_themes(&file, None)?,
+                t.projection.packed(),
+            ))
+        }
+        None => None,
+    };
+    let theme_view = themes.as_ref().map(|(set, (kind, projection))| ThemeView {
+        look: set.lookup(0),
+        kind: *kind,
+        projection: *projection,
+        eye: view.eye.map(|v| v as f32),
+        pixel_angle: 2.0 * view.tan_x as f32 / w as f32,
+    });
+    let albedo = |d: [f64; 3], t: f64| {
+        let tv = theme_view.as_ref().expect("only called with themes");
+        themed_albedo(tv, d.map(|v| v as f32), t as f32).map(|v| v as f64)
+    };
     let t0 = Instant::now();
-    let frame = freeform::render(&field, &view, &method, &light);
+    let frame = freeform::shade::render_with(
+        &field,
+        &view,
+        &method,
+        &light,
+        theme_view.is_some().then_some(&albedo as _),
+    );
     let seconds = t0.elapsed().as_secs_f64();
     let mut img = image::RgbaImage::new(w, h);
     for (px, rgb) in img.pixels_mut().zip(&frame.rgb) {
