@@ -74,29 +74,39 @@ fn theme_class_at(level: u32, p: vec2<f32>) -> u32 {
     return word & 0xffu;
 }
 
-// Bilinear sample (wrap) of the turbulence map at (u, v), period 1.
-fn theme_noise(uv: vec2<f32>) -> vec2<f32> {
-    let n = f32(theme.noise_size);
-    let x = (uv.x - floor(uv.x)) * n - 0.5;
-    let y = (uv.y - floor(uv.y)) * n - 0.5;
+// Where a bilinear sample of an n×n grid that wraps falls at uv (periods, texel centres at
+// (i + ½)/n): the corner texel and the weights. Twin of relume::theme::noise::wrap_bilinear.
+struct WrapBilinear {
+    c0: i32,
+    r0: i32,
+    fx: f32,
+    fy: f32,
+}
+
+fn wrap_bilinear(uv: vec2<f32>, n: i32) -> WrapBilinear {
+    let nf = f32(n);
+    let x = (uv.x - floor(uv.x)) * nf - 0.5;
+    let y = (uv.y - floor(uv.y)) * nf - 0.5;
     let x0 = floor(x);
     let y0 = floor(y);
-    let fx = x - x0;
-    let fy = y - y0;
-    let m = i32(theme.noise_size);
-    let c0 = i32(x0);
-    let r0 = i32(y0);
-    let a = theme_noise_at(c0, r0, m);
-    let b = theme_noise_at(c0 + 1, r0, m);
-    let c = theme_noise_at(c0, r0 + 1, m);
-    let d = theme_noise_at(c0 + 1, r0 + 1, m);
-    let top = a + (b - a) * fx;
-    let bottom = c + (d - c) * fx;
-    return top + (bottom - top) * fy;
+    return WrapBilinear(i32(x0), i32(y0), x - x0, y - y0);
 }
 
 fn wrap_i(v: i32, m: i32) -> i32 {
     return ((v % m) + m) % m;
+}
+
+// Bilinear sample (wrap) of the turbulence map at (u, v), period 1.
+fn theme_noise(uv: vec2<f32>) -> vec2<f32> {
+    let m = i32(theme.noise_size);
+    let w = wrap_bilinear(uv, m);
+    let a = theme_noise_at(w.c0, w.r0, m);
+    let b = theme_noise_at(w.c0 + 1, w.r0, m);
+    let c = theme_noise_at(w.c0, w.r0 + 1, m);
+    let d = theme_noise_at(w.c0 + 1, w.r0 + 1, m);
+    let top = a + (b - a) * w.fx;
+    let bottom = c + (d - c) * w.fx;
+    return top + (bottom - top) * w.fy;
 }
 
 fn theme_noise_at(c: i32, r: i32, m: i32) -> vec2<f32> {
@@ -125,22 +135,14 @@ fn theme_level_offset(l: u32) -> u32 {
 fn theme_bilinear(t: u32, l: u32, st: vec2<f32>) -> vec3<f32> {
     let n = i32(theme.tex_size >> l);
     let base = t * theme.per_theme + theme_level_offset(l);
-    let nf = f32(n);
-    let x = (st.x - floor(st.x)) * nf - 0.5;
-    let y = (st.y - floor(st.y)) * nf - 0.5;
-    let x0 = floor(x);
-    let y0 = floor(y);
-    let fx = x - x0;
-    let fy = y - y0;
-    let c0 = i32(x0);
-    let r0 = i32(y0);
-    let a = theme_texel_rgb(base, c0, r0, n);
-    let b = theme_texel_rgb(base, c0 + 1, r0, n);
-    let c = theme_texel_rgb(base, c0, r0 + 1, n);
-    let d = theme_texel_rgb(base, c0 + 1, r0 + 1, n);
-    let top = a + (b - a) * fx;
-    let bottom = c + (d - c) * fx;
-    return top + (bottom - top) * fy;
+    let w = wrap_bilinear(st, n);
+    let a = theme_texel_rgb(base, w.c0, w.r0, n);
+    let b = theme_texel_rgb(base, w.c0 + 1, w.r0, n);
+    let c = theme_texel_rgb(base, w.c0, w.r0 + 1, n);
+    let d = theme_texel_rgb(base, w.c0 + 1, w.r0 + 1, n);
+    let top = a + (b - a) * w.fx;
+    let bottom = c + (d - c) * w.fx;
+    return top + (bottom - top) * w.fy;
 }
 
 fn theme_trilinear(t: u32, lod_in: f32, st: vec2<f32>) -> vec3<f32> {

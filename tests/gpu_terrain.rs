@@ -15,6 +15,7 @@ use relume::terrain::hard_f32::{shadowed_accelerated_f32, shadowed_exact_f32, Tr
 use relume::terrain::relief::{shadow_mask, HardMethod};
 use relume::terrain::sun::{Sun, Track};
 use relume::terrain::MinMaxMipmap;
+use relume::theme::ThemeSet;
 
 fn srtm_half() -> HeightMap {
     let (m, _) = load_heightmap(
@@ -117,7 +118,7 @@ fn map_view_difference(
     map: &HeightMap,
     sun: Sun,
     shadow: impl Fn(&TerrainRenderer) -> Vec<bool>,
-    themes: Option<(&relume::theme::ThemeSet, u32)>,
+    themes: Option<(&ThemeSet, u32)>,
 ) -> (f64, u8) {
     r.set_sun(gpu, sun);
     if let Some((set, frame)) = themes {
@@ -154,27 +155,32 @@ fn map_view_difference(
     (sum as f64 / n as f64, worst)
 }
 
+/// The map view of `map` (traversal shadows, sun 300°/12°, themes when given) against the CPU
+/// shading: same formulas in f32 on both sides; the GPU's pow/exp differ by ulps, so 8-bit
+/// values may differ by one step at rounding boundaries (measured: max 1/255, mean 0.0000).
+fn assert_map_view_matches(gpu: &Gpu, map: &HeightMap, themes: Option<(&ThemeSet, u32)>) {
+    let mip = MinMaxMipmap::build(map);
+    let (w, h) = (map.width as u32, map.height as u32);
+    let mut r = TerrainRenderer::new(gpu, map, &mip, w, h, Some(1)).unwrap();
+    let sun = Sun::new(300.0, 12.0).unwrap();
+    let (mean, worst) = map_view_difference(
+        gpu,
+        &mut r,
+        map,
+        sun,
+        |r| r.shadow_mask(gpu, true).unwrap(),
+        themes,
+    );
+    let what = if themes.is_some() { "themed" } else { "plain" };
+    eprintln!("{what} terrain map view: mean |GPU − CPU| = {mean:.4}/255, max {worst}/255");
+    assert!(worst <= 1, "{what}: max difference {worst}/255");
+    assert!(mean < 0.05, "{what}: mean difference {mean}");
+}
+
 #[test]
 fn map_view_matches_the_cpu_shading() {
     let Some(gpu) = gpu() else { return };
-    let map = srtm_half();
-    let mip = MinMaxMipmap::build(&map);
-    let (w, h) = (map.width as u32, map.height as u32);
-    let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
-    let sun = Sun::new(300.0, 12.0).unwrap();
-    let (mean, worst) = map_view_difference(
-        &gpu,
-        &mut r,
-        &map,
-        sun,
-        |r| r.shadow_mask(&gpu, true).unwrap(),
-        None,
-    );
-    eprintln!("terrain map view: mean |GPU − CPU| = {mean:.4}/255, max {worst}/255");
-    // Same formulas in f32 on both sides; the GPU's pow/exp differ by ulps, so 8-bit values may
-    // differ by one step at rounding boundaries.
-    assert!(worst <= 1, "max difference {worst}/255");
-    assert!(mean < 0.05, "mean difference {mean}");
+    assert_map_view_matches(&gpu, &srtm_half(), None);
 }
 
 #[test]
@@ -187,21 +193,7 @@ fn themed_map_view_matches_the_cpu_shading() {
     let set =
         relume::load::themes::load_themes(&common::data("themes/puget-sound.ron"), Some(&map))
             .unwrap();
-    let mip = MinMaxMipmap::build(&map);
-    let (w, h) = (map.width as u32, map.height as u32);
-    let mut r = TerrainRenderer::new(&gpu, &map, &mip, w, h, Some(1)).unwrap();
-    let sun = Sun::new(300.0, 12.0).unwrap();
-    let (mean, worst) = map_view_difference(
-        &gpu,
-        &mut r,
-        &map,
-        sun,
-        |r| r.shadow_mask(&gpu, true).unwrap(),
-        Some((&set, 3)),
-    );
-    eprintln!("themed map view: mean |GPU − CPU| = {mean:.4}/255, max {worst}/255");
-    assert!(worst <= 1, "max difference {worst}/255");
-    assert!(mean < 0.05, "mean difference {mean}");
+    assert_map_view_matches(&gpu, &map, Some((&set, 3)));
 }
 
 #[test]

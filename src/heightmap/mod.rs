@@ -293,6 +293,27 @@ impl HeightMap {
         self.heights[y * self.width + x]
     }
 
+    /// (∂z/∂x east, ∂z/∂y north) at texel (x, y) in metres per metre: central differences,
+    /// one-sided at the border, 0 along an axis one texel wide (the shaders' `lambert_at`).
+    pub fn gradient(&self, x: usize, y: usize) -> (f64, f64) {
+        let (w, h) = (self.width, self.height);
+        let [cx, cy] = self.cell_size;
+        let (c0, c1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+        let (r0, r1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+        let dzdx = if c1 > c0 {
+            (self.at(c1, y) as f64 - self.at(c0, y) as f64) / ((c1 - c0) as f64 * cx)
+        } else {
+            0.0
+        };
+        // Rows go south: north is r0.
+        let dzdy = if r1 > r0 {
+            (self.at(x, r0) as f64 - self.at(x, r1) as f64) / ((r1 - r0) as f64 * cy)
+        } else {
+            0.0
+        };
+        (dzdx, dzdy)
+    }
+
     /// Minimum and maximum height.
     pub fn min_max(&self) -> (f32, f32) {
         self.heights

@@ -102,24 +102,11 @@ pub fn check_k(k_dark: f64, k_bright: f64) -> Result<()> {
 pub fn lambert(map: &HeightMap, sun: &Sun) -> Vec<f32> {
     let s = sun.direction();
     let (w, h) = (map.width, map.height);
-    let [cx, cy] = map.cell_size;
     (0..h)
         .into_par_iter()
         .flat_map_iter(|r| {
             (0..w).map(move |c| {
-                let (c0, c1) = (c.saturating_sub(1), (c + 1).min(w - 1));
-                let (r0, r1) = (r.saturating_sub(1), (r + 1).min(h - 1));
-                let dzdx = if c1 > c0 {
-                    (map.at(c1, r) as f64 - map.at(c0, r) as f64) / ((c1 - c0) as f64 * cx)
-                } else {
-                    0.0
-                };
-                // Rows go south: north is r0.
-                let dzdy = if r1 > r0 {
-                    (map.at(c, r0) as f64 - map.at(c, r1) as f64) / ((r1 - r0) as f64 * cy)
-                } else {
-                    0.0
-                };
+                let (dzdx, dzdy) = map.gradient(c, r);
                 let n = [-dzdx, -dzdy, 1.0];
                 let len = (n[0] * n[0] + n[1] * n[1] + 1.0).sqrt();
                 let l = (n[0] * s[0] + n[1] * s[1] + n[2] * s[2]) / len;

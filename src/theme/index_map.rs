@@ -80,21 +80,7 @@ pub struct Rule {
 /// Slope (degrees) and aspect (degrees clockwise from north, downhill; 0 on flat ground) at a
 /// texel from central differences (one-sided at the border), in metres.
 pub fn slope_aspect(map: &HeightMap, col: usize, row: usize) -> (f64, f64) {
-    let (w, h) = (map.width, map.height);
-    let [cx, cy] = map.cell_size;
-    let (c0, c1) = (col.saturating_sub(1), (col + 1).min(w - 1));
-    let (r0, r1) = (row.saturating_sub(1), (row + 1).min(h - 1));
-    let dzdx = if c1 > c0 {
-        (map.at(c1, row) as f64 - map.at(c0, row) as f64) / ((c1 - c0) as f64 * cx)
-    } else {
-        0.0
-    };
-    // Rows go south: the northern neighbour is r0.
-    let dzdy = if r1 > r0 {
-        (map.at(col, r0) as f64 - map.at(col, r1) as f64) / ((r1 - r0) as f64 * cy)
-    } else {
-        0.0
-    };
+    let (dzdx, dzdy) = map.gradient(col, row);
     let slope = dzdx.hypot(dzdy).atan().to_degrees();
     let aspect = if dzdx == 0.0 && dzdy == 0.0 {
         0.0

@@ -11,7 +11,7 @@
 //! signed values, so this is the signed fractal sum.)
 //!
 //! Sampling ([`TurbulenceMap::sample`]) is bilinear with wrap-around in f32: the twin of
-//! `noise_at` in `shaders/theme.wgsl`.
+//! `theme_noise` in `shaders/theme.wgsl`.
 
 /// A `size`×`size` two-channel turbulence map over one period of the unit square.
 #[derive(Clone, Debug, PartialEq)]
@@ -112,28 +112,40 @@ impl TurbulenceMap {
         TurbulenceMap { size: n, values }
     }
 
-    /// Bilinear sample with wrap-around at (u, v) (period 1): twin of `noise_at`.
+    /// Bilinear sample with wrap-around at (u, v) (period 1): twin of `theme_noise`.
     pub fn sample(&self, u: f32, v: f32) -> [f32; 2] {
-        let n = self.size as f32;
-        let x = (u - u.floor()) * n - 0.5;
-        let y = (v - v.floor()) * n - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
         let m = self.size as i32;
-        let at = |c: i32, r: i32| self.values[(r.rem_euclid(m) * m + c.rem_euclid(m)) as usize];
-        let (c0, r0) = (x0 as i32, y0 as i32);
-        let (a, b, c, d) = (
-            at(c0, r0),
-            at(c0 + 1, r0),
-            at(c0, r0 + 1),
-            at(c0 + 1, r0 + 1),
-        );
-        [0, 1].map(|k| {
-            let top = a[k] + (b[k] - a[k]) * fx;
-            let bottom = c[k] + (d[k] - c[k]) * fx;
-            top + (bottom - top) * fy
-        })
+        wrap_bilinear(m, u, v, |c, r| self.values[(r * m + c) as usize])
     }
+}
+
+/// Bilinear interpolation of an n×n grid that wraps, at (u, v) in periods (texel centres at
+/// (i + ½)/n), fetching wrapped texels (column, row) from `fetch`: the arithmetic of
+/// `wrap_bilinear` in `shaders/theme.wgsl`, shared by the turbulence map and theme textures.
+pub fn wrap_bilinear<const K: usize>(
+    n: i32,
+    u: f32,
+    v: f32,
+    fetch: impl Fn(i32, i32) -> [f32; K],
+) -> [f32; K] {
+    let nf = n as f32;
+    let x = (u - u.floor()) * nf - 0.5;
+    let y = (v - v.floor()) * nf - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let at = |c: i32, r: i32| fetch(c.rem_euclid(n), r.rem_euclid(n));
+    let (c0, r0) = (x0 as i32, y0 as i32);
+    let (a, b, c, d) = (
+        at(c0, r0),
+        at(c0 + 1, r0),
+        at(c0, r0 + 1),
+        at(c0 + 1, r0 + 1),
+    );
+    std::array::from_fn(|k| {
+        let top = a[k] + (b[k] - a[k]) * fx;
+        let bottom = c[k] + (d[k] - c[k]) * fx;
+        top + (bottom - top) * fy
+    })
 }
 
 #[cfg(test)]

@@ -178,26 +178,9 @@ impl ThemeTextures {
     pub fn bilinear(&self, lut: &[f32; 256], theme: usize, l: usize, s: f32, t: f32) -> [f32; 3] {
         let n = (self.size >> l) as i32;
         let base = theme * self.per_theme() + self.level_offset(l);
-        let nf = n as f32;
-        let x = (s - s.floor()) * nf - 0.5;
-        let y = (t - t.floor()) * nf - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let at = |c: i32, r: i32| {
-            let p = self.texels[base + (r.rem_euclid(n) * n + c.rem_euclid(n)) as usize];
+        super::noise::wrap_bilinear(n, s, t, |c, r| {
+            let p = self.texels[base + (r * n + c) as usize];
             [lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]]
-        };
-        let (c0, r0) = (x0 as i32, y0 as i32);
-        let (a, b, c, d) = (
-            at(c0, r0),
-            at(c0 + 1, r0),
-            at(c0, r0 + 1),
-            at(c0 + 1, r0 + 1),
-        );
-        [0, 1, 2].map(|k| {
-            let top = a[k] + (b[k] - a[k]) * fx;
-            let bottom = c[k] + (d[k] - c[k]) * fx;
-            top + (bottom - top) * fy
         })
     }
 
