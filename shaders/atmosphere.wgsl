@@ -73,7 +73,7 @@ fn atmo_transmittance(r: f32, mu: f32) -> vec3<f32> {
 }
 
 fn atmo_multi_scattering(r: f32, mu_s: f32) -> vec3<f32> {
-    let y = (r - atmo.radii.x) / (atmo.radii.y - atmo.radii.x);
+    let y = sqrt(max((r - atmo.radii.x) / (atmo.radii.y - atmo.radii.x), 0.0));
     let b = atmo_bilinear(MULTI_W, MULTI_H, 0.5 * mu_s + 0.5, y);
     return atmo_mix_bilinear(b, multi_lut[b.i00].xyz, multi_lut[b.i10].xyz, multi_lut[b.i01].xyz,
         multi_lut[b.i11].xyz);
@@ -123,16 +123,18 @@ fn build_multi_scattering(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let mu_s = 2.0 * atmo_unit_of(n % MULTI_W, MULTI_W) - 1.0;
-    let r = atmo.radii.x + atmo_unit_of(n / MULTI_W, MULTI_H) * (atmo.radii.y - atmo.radii.x);
+    let y = atmo_unit_of(n / MULTI_W, MULTI_H);
+    let r = atmo.radii.x + y * y * (atmo.radii.y - atmo.radii.x);
     let o = vec3<f32>(0.0, r, 0.0);
     let sun = vec3<f32>(sqrt(max(1.0 - mu_s * mu_s, 0.0)), mu_s, 0.0);
     let iso = 1.0 / (4.0 * PI);
     var l2 = vec3<f32>(0.0);
     var fms = vec3<f32>(0.0);
-    for (var a = 0u; a < 8u; a++) {
-        for (var bb = 0u; bb < 8u; bb++) {
-            let theta = 2.0 * PI * (f32(a) + 0.5) / 8.0;
-            let cos_phi = 1.0 - 2.0 * (f32(bb) + 0.5) / 8.0;
+    let side = f32(MULTI_DIRECTIONS);
+    for (var a = 0u; a < MULTI_DIRECTIONS; a++) {
+        for (var bb = 0u; bb < MULTI_DIRECTIONS; bb++) {
+            let theta = 2.0 * PI * (f32(a) + 0.5) / side;
+            let cos_phi = 1.0 - 2.0 * (f32(bb) + 0.5) / side;
             let sin_phi = sqrt(max(1.0 - cos_phi * cos_phi, 0.0));
             let dir = vec3<f32>(cos(theta) * sin_phi, cos_phi, sin(theta) * sin_phi);
             let t_ground = ray_sphere_nearest(o, dir, atmo.radii.x);
@@ -168,8 +170,8 @@ fn build_multi_scattering(@builtin(global_invocation_id) id: vec3<u32>) {
             fms += f;
         }
     }
-    l2 /= 64.0;
-    fms /= 64.0;
+    l2 /= side * side;
+    fms /= side * side;
     atmo_out[n] = vec4<f32>(l2 / (vec3<f32>(1.0) - fms), 1.0);
 }
 

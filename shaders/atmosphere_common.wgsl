@@ -27,6 +27,8 @@ const SKY_H: u32 = 108u;
 const AERIAL_N: u32 = 32u;
 const STEPS_TRANSMITTANCE: u32 = 40u;
 const STEPS_MULTI: u32 = 20u;
+// Directions per axis of the multiple-scattering sphere (twin.rs MULTI_DIRECTIONS).
+const MULTI_DIRECTIONS: u32 = 8u;
 const STEPS_SKY: u32 = 30u;
 const STEPS_AERIAL: u32 = 20u;
 
@@ -59,7 +61,9 @@ fn ray_sphere_nearest(o: vec3<f32>, d: vec3<f32>, r: f32) -> f32 {
     let b = dot(o, d);
     let c = dot(o, o) - r * r;
     let disc = b * b - c;
-    if (disc < 0.0) {
+    // On or outside the sphere heading away: no hit (not the root t = 0 of a ray leaving the
+    // ground, which would make every direction from the ground see the ground).
+    if (disc < 0.0 || (c >= 0.0 && b >= 0.0)) {
         return -1.0;
     }
     let q = sqrt(disc);

@@ -253,10 +253,12 @@ fn hillaire_and_the_seed_against_the_reference_by_sun_elevation() {
     }
     // Measured (release, deterministic seeds): the largest relative error of the in-scattered
     // radiance over the views, per elevation, for Hillaire's aerial-perspective volume and its
-    // sky view. Bounds: measured × 1.25 (float differences between platforms move the
-    // reference's Monte Carlo part by a fraction of its standard error, at most 26 %).
-    let aerial = [24.8, 21.4, 29.1, 39.5, 45.6, 57.2, 71.9, 73.7, 84.5];
-    let sky = [8.7, 9.9, 13.4, 16.0, 17.1, 18.5, 19.3, 18.2, 31.0];
+    // sky view (after the multiple-scattering table's ground-row fix; before it the aerial
+    // row read 24.8, 21.4, 29.1, 39.5, 45.6, 57.2, 71.9, 73.7, 84.5). Bounds: measured × 1.25
+    // (float differences between platforms move the reference's Monte Carlo part by a fraction
+    // of its standard error, at most 26 %).
+    let aerial = [16.8, 16.6, 20.5, 23.9, 25.8, 30.1, 36.7, 33.3, 46.6];
+    let sky = [8.7, 9.5, 11.7, 13.3, 14.0, 15.2, 15.9, 14.0, 27.4];
     for (k, r) in rows.iter().enumerate() {
         assert!(r.hillaire_aerial < 1.25e-2 * aerial[k], "{r:?}");
         assert!(r.hillaire_sky < 1.25e-2 * sky[k], "{r:?}");
@@ -274,6 +276,6 @@ fn hillaire_and_the_seed_against_the_reference_by_sun_elevation() {
     // Against the full reference the seed is never within 30 %: it lacks multiple scattering
     // (45–61 % at and above 15°).
     assert_eq!(lowest_within(&rows, |r| r.fog, 0.3), None);
-    // Hillaire's sky view stays within 20 % down to 0° (measured 19.3 % at 2°).
+    // Hillaire's sky view stays within 20 % down to 0° (measured 15.9 % at 2°, 27.4 % at −2°).
     assert_eq!(lowest_within(&rows, |r| r.hillaire_sky, 0.2), Some(0.0));
 }

@@ -118,3 +118,109 @@ fn hillaire_single_and_multiple_parts() {
         eprintln!("sun {sun_el}: Hillaire single part vs quadrature max rel {ws:.4}; multiple part vs MC orders>=2 max rel {wm:.4}");
     }
 }
+
+/// Measurement, not an assertion (slow): where Hillaire's multiple part goes wrong. For each
+/// sun and view segment, Hillaire's multiple part (full march − march with Ψ_ms zeroed) with the
+/// twin's table (8² directions, 20 steps) and a CPU-only fine one (32² directions, 100 steps),
+/// against the tracer's orders ≥ 2 with the real phase functions and with every phase
+/// isotropic (the medium Ψ_ms assumes). Then with a black ground: the table's order two alone
+/// (L₂, no series) against the isotropic tracer's order two, and the full series against its
+/// orders ≥ 2. `RELUME_MC_PATHS` sets the paths (default 10,000).
+#[test]
+#[ignore]
+fn hillaire_multiple_part_diagnosis() {
+    use relume::atmosphere::lut::MultiQuality;
+    let paths = std::env::var("RELUME_MC_PATHS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(10_000);
+    let fine = MultiQuality {
+        side: 32,
+        steps: 100,
+        all_orders: true,
+    };
+    let l2_only = MultiQuality {
+        all_orders: false,
+        ..MultiQuality::TWIN
+    };
+    for black in [false, true] {
+        let mut atm = Atmosphere::earth();
+        if black {
+            atm.ground_albedo = [0.0; 3];
+        }
+        for sun_el in [90.0, 60.0, 30.0, 10.0] {
+            let sun = direction(sun_el, 0.0);
+            let p = AtmosphereGpu::new(&atm, 1500.0, sun, 128_000.0);
+            let multi = |l: &Luts, d, s| {
+                let mut z = l.clone();
+                for v in &mut z.multi_scattering {
+                    *v = [0.0; 4];
+                }
+                let (full, _) = l.march_segment(d, s, 64);
+                let (single, _) = z.march_segment(d, s, 64);
+                full - single
+            };
+            let twin = Luts::build(&p);
+            let other = Luts::build_with(&p, if black { l2_only } else { fine });
+            for (el, az, s) in [
+                (0.0, 0.0, 10_000.0),
+                (0.0, 90.0, 10_000.0),
+                (0.0, 180.0, 10_000.0),
+                (0.0, 90.0, 100_000.0),
+                (-5.0, 90.0, 100_000.0),
+            ] {
+                let ray = ViewRay {
+                    eye_altitude: 1500.0,
+                    dir: direction(el, az),
+                    sun,
+                    length: Some(s),
+                };
+                let (_, len) = ray.start_and_length(&atm);
+                let d = direction(el, az).as_vec3();
+                let km = (len / 1000.0) as f32;
+                let (ht, ho) = (multi(&twin, d, km), multi(&other, d, km));
+                let opts = McOptions {
+                    paths,
+                    ..McOptions::default()
+                };
+                let mc = trace(&atm, &ray, &opts);
+                let iso = trace(
+                    &atm,
+                    &ray,
+                    &McOptions {
+                        isotropic: true,
+                        ..opts
+                    },
+                );
+                let r = |h: f32, m: f64| h as f64 / m - 1.0;
+                for c in 0..3 {
+                    let head = format!(
+                        "sun {sun_el:>2} el {el:>3} az {az:>3} s {:>3} km c{c}:",
+                        s / 1000.0
+                    );
+                    if black {
+                        eprintln!(
+                            "black {head} L2/iso2 {:+.3} (se {:.3}) | twin/iso {:+.3} (se {:.3}) | twin/MC {:+.3}",
+                            r(ho[c], iso.order2[c]),
+                            iso.order2_se[c] / iso.order2[c],
+                            r(ht[c], iso.multiple[c]),
+                            iso.multiple_se[c] / iso.multiple[c],
+                            r(ht[c], mc.multiple[c]),
+                        );
+                    } else {
+                        eprintln!(
+                            "{head} twin/MC {:+.3} fine/MC {:+.3} | twin/iso {:+.3} fine/iso {:+.3} | iso/MC {:+.3} (MC se {:.3}, iso se {:.3})",
+                            r(ht[c], mc.multiple[c]),
+                            r(ho[c], mc.multiple[c]),
+                            r(ht[c], iso.multiple[c]),
+                            r(ho[c], iso.multiple[c]),
+                            iso.multiple[c] / mc.multiple[c] - 1.0,
+                            mc.multiple_se[c] / mc.multiple[c],
+                            iso.multiple_se[c] / iso.multiple[c],
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

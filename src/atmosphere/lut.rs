@@ -65,7 +65,7 @@ pub fn transmittance(p: &AtmosphereGpu, tab: &[[f32; 4]], r: f32, mu: f32) -> Ve
 /// Ψ_ms at radius `r` for sun zenith cosine `mu_s` (table lookup).
 pub fn multi_scattering(p: &AtmosphereGpu, tab: &[[f32; 4]], r: f32, mu_s: f32) -> Vec3 {
     let [w, h] = MULTI_SCATTERING_SIZE;
-    let y = (r - p.ground()) / (p.top() - p.ground());
+    let y = ((r - p.ground()) / (p.top() - p.ground())).max(0.0).sqrt();
     sample2(tab, w, h, 0.5 * mu_s + 0.5, y)
 }
 
@@ -88,6 +88,7 @@ fn multi_direction(
     o: Vec3,
     dir: Vec3,
     sun: Vec3,
+    n: u32,
 ) -> (Vec3, Vec3) {
     let t_ground = ray_sphere_nearest(o, dir, p.ground());
     let t_top = ray_sphere_nearest(o, dir, p.top());
@@ -96,7 +97,6 @@ fn multi_direction(
     } else {
         t_top.max(0.0)
     };
-    let n = STEPS[1];
     let dt = t_max / n as f32;
     let iso = 1.0 / (4.0 * std::f32::consts::PI);
     let (mut l, mut f, mut thr) = (Vec3::ZERO, Vec3::ZERO, Vec3::ONE);
@@ -122,6 +122,25 @@ fn multi_direction(
     (l, f)
 }
 
+/// The sampling of the multiple-scattering table: directions per axis (`side`² in all, uniform
+/// on the sphere) and raymarch steps per direction. [`MultiQuality::TWIN`] is what the WGSL
+/// kernel uses; others are CPU-only, for measuring the table's own resolution error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MultiQuality {
+    pub side: usize,
+    pub steps: u32,
+    /// Hillaire's infinite isotropic series L₂/(1 − f_ms); false keeps order two (L₂) alone.
+    pub all_orders: bool,
+}
+
+impl MultiQuality {
+    pub const TWIN: MultiQuality = MultiQuality {
+        side: MULTI_DIRECTIONS,
+        steps: STEPS[1],
+        all_orders: true,
+    };
+}
+
 /// Multiple-scattering texel (i, j).
 pub fn multi_scattering_texel(
     p: &AtmosphereGpu,
@@ -129,27 +148,44 @@ pub fn multi_scattering_texel(
     i: usize,
     j: usize,
 ) -> [f32; 4] {
+    multi_scattering_texel_with(p, trans, i, j, MultiQuality::TWIN)
+}
+
+/// Multiple-scattering texel (i, j) with the sampling `q`.
+pub fn multi_scattering_texel_with(
+    p: &AtmosphereGpu,
+    trans: &[[f32; 4]],
+    i: usize,
+    j: usize,
+    q: MultiQuality,
+) -> [f32; 4] {
     let [w, h] = MULTI_SCATTERING_SIZE;
     let mu_s = 2.0 * unit(i, w) - 1.0;
-    let r = p.ground() + unit(j, h) * (p.top() - p.ground());
+    let y = unit(j, h);
+    let r = p.ground() + y * y * (p.top() - p.ground());
     let o = Vec3::new(0.0, r, 0.0);
     let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), mu_s, 0.0);
     let (mut l2, mut fms) = (Vec3::ZERO, Vec3::ZERO);
-    for a in 0..8 {
-        for b in 0..8 {
-            let theta = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / 8.0;
-            let cos_phi = 1.0 - 2.0 * (b as f32 + 0.5) / 8.0;
+    let side = q.side;
+    for a in 0..side {
+        for b in 0..side {
+            let theta = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / side as f32;
+            let cos_phi = 1.0 - 2.0 * (b as f32 + 0.5) / side as f32;
             let sin_phi = (1.0 - cos_phi * cos_phi).max(0.0).sqrt();
             let dir = Vec3::new(theta.cos() * sin_phi, cos_phi, theta.sin() * sin_phi);
-            let (l, f) = multi_direction(p, trans, o, dir, sun);
+            let (l, f) = multi_direction(p, trans, o, dir, sun, q.steps);
             l2 += l;
             fms += f;
         }
     }
     // Averages over the sphere (the isotropic phase is inside L₂ already; f_ms is ∫T·σ_s
     // averaged over directions, i.e. with the isotropic phase times 4π).
-    l2 /= 64.0;
-    fms /= 64.0;
+    let count = (side * side) as f32;
+    l2 /= count;
+    fms /= count;
+    if !q.all_orders {
+        return quad(l2, 1.0);
+    }
     quad(l2 / (Vec3::ONE - fms), 1.0)
 }
 
@@ -255,6 +291,11 @@ pub fn aerial_texels(
 impl Luts {
     /// Build every table on the CPU (the twin of `gpu::atmosphere`).
     pub fn build(params: &AtmosphereGpu) -> Luts {
+        Luts::build_with(params, MultiQuality::TWIN)
+    }
+
+    /// Build every table with the multiple-scattering sampling `q` (CPU only).
+    pub fn build_with(params: &AtmosphereGpu, q: MultiQuality) -> Luts {
         let p = params;
         let [tw, th] = TRANSMITTANCE_SIZE;
         let transmittance: Vec<_> = (0..tw * th)
@@ -264,7 +305,7 @@ impl Luts {
         let [mw, mh] = MULTI_SCATTERING_SIZE;
         let multi_scattering: Vec<_> = (0..mw * mh)
             .into_par_iter()
-            .map(|n| multi_scattering_texel(p, &transmittance, n % mw, n / mw))
+            .map(|n| multi_scattering_texel_with(p, &transmittance, n % mw, n / mw, q))
             .collect();
         let [sw, sh] = SKY_VIEW_SIZE;
         let sky_view: Vec<_> = (0..sw * sh)

@@ -32,6 +32,10 @@ pub struct McOptions {
     pub max_events: usize,
     /// Panel-length factor of the quadrature of the sun's transmittance at each event.
     pub sun_panel_scale: f64,
+    /// Every phase function replaced by the isotropic 1/(4π) (Rayleigh + Mie scattering
+    /// together): the medium Hillaire's Ψ_ms assumes, to separate the isotropic
+    /// approximation's error from the table's.
+    pub isotropic: bool,
 }
 
 impl Default for McOptions {
@@ -41,6 +45,7 @@ impl Default for McOptions {
             seed: 0x0a7e_05be_1e5e_ed01,
             max_events: 64,
             sun_panel_scale: 4.0,
+            isotropic: false,
         }
     }
 }
@@ -113,17 +118,22 @@ impl Scatter<'_> {
         let m = atm.medium(atm.altitude(x));
         let mu_sun = d.dot(self.sun);
         let ts = reference::sun_transmittance_scaled(atm, x, self.sun, self.opts.sun_panel_scale);
-        let (pr, pm) = (
-            rayleigh_phase(mu_sun),
-            cornette_shanks_phase(mu_sun, atm.mie_g),
-        );
+        let iso = self.opts.isotropic;
+        let phases = |mu: f64| {
+            if iso {
+                (0.25 / PI, 0.25 / PI)
+            } else {
+                (rayleigh_phase(mu), cornette_shanks_phase(mu, atm.mie_g))
+            }
+        };
+        let (pr, pm) = phases(mu_sun);
         let nee: [f64; 3] = std::array::from_fn(|c| {
             w[c] * (m.rayleigh[c] * pr + m.mie[c] * pm) / norm * ts[c] * atm.sun_illuminance[c]
         });
         // Continue: Rayleigh (uniform) or Mie (HG) by the channel-mean coefficients.
         let sr: f64 = m.rayleigh.iter().sum();
         let sm: f64 = m.mie.iter().sum();
-        let p_r = sr / (sr + sm).max(1e-300);
+        let p_r = if iso { 1.0 } else { sr / (sr + sm).max(1e-300) };
         let (u1, u2, u3) = (rng.uniform(), rng.uniform(), rng.uniform());
         let phi = 2.0 * PI * u3;
         let cos_t = if u1 < p_r {
@@ -133,10 +143,7 @@ impl Scatter<'_> {
         };
         let nd = around(d, cos_t, phi);
         let q = p_r / (4.0 * PI) + (1.0 - p_r) * henyey_greenstein_phase(cos_t, atm.mie_g);
-        let (pr, pm) = (
-            rayleigh_phase(cos_t),
-            cornette_shanks_phase(cos_t, atm.mie_g),
-        );
+        let (pr, pm) = phases(cos_t);
         for c in 0..3 {
             w[c] *= (m.rayleigh[c] * pr + m.mie[c] * pm) / (norm * q);
         }

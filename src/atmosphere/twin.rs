@@ -10,7 +10,8 @@
 //! - transmittance (r, μ) → (x_μ, x_r): with H = √(top² − R²), ρ = √(r² − R²), x_r = ρ/H, and d
 //!   the distance to the top along μ, x_μ = (d − d_min)/(d_max − d_min), d_min = top − r,
 //!   d_max = ρ + H (Bruneton 2017; only rays that miss the ground).
-//! - multiple scattering (r, μ_s) → (μ_s/2 + 1/2, (r − R)/(top − R)).
+//! - multiple scattering (r, μ_s) → (μ_s/2 + 1/2, √((r − R)/(top − R))): rows dense near the
+//!   ground, where Ψ_ms bends (its lower hemisphere turns from ground to air).
 //! - sky view (view zenith θ, azimuth φ from the sun) at the eye: u = √(φ/π); with the
 //!   horizon's zenith angle θ_h = π − β, β = acos(ρ/r): v = ½·(1 − √(1 − θ/θ_h)) above the
 //!   horizon, v = ½ + ½·√((θ − θ_h)/β) below (Hillaire's non-linear latitude, dense at the
@@ -28,6 +29,8 @@ pub const SKY_VIEW_SIZE: [usize; 2] = [192, 108];
 /// Texels of the aerial-perspective volume (azimuth, zenith, distance); two texels each
 /// (in-scattering, then transmittance).
 pub const AERIAL_SIZE: [usize; 3] = [32, 32, 32];
+/// Directions per axis of the multiple-scattering table's sphere (the square of it in all).
+pub const MULTI_DIRECTIONS: usize = 8;
 /// Quadrature steps: transmittance, multiple scattering (per direction), sky view, aerial.
 pub const STEPS: [u32; 4] = [40, 20, 30, 20];
 
@@ -124,12 +127,15 @@ pub fn cornette_shanks_phase(mu: f32, g: f32) -> f32 {
 }
 
 /// Nearest non-negative distance from `o` along unit `d` to the sphere of radius `r` about
-/// the origin, or −1 when there is none.
+/// the origin, or −1 when there is none (also from on the sphere heading outward).
 pub fn ray_sphere_nearest(o: Vec3, d: Vec3, r: f32) -> f32 {
     let b = o.dot(d);
     let c = o.dot(o) - r * r;
     let disc = b * b - c;
-    if disc < 0.0 {
+    // On or outside the sphere heading away: no hit. (Without this a ray leaving a point on
+    // the ground returned its root t = 0, and the multiple-scattering table's bottom row saw
+    // ground in every direction: air light lost, ground light doubled.)
+    if disc < 0.0 || (c >= 0.0 && b >= 0.0) {
         return -1.0;
     }
     let q = disc.sqrt();

@@ -15,6 +15,7 @@
 //! (a table per sweep with ratios against the sweep's baseline setting) and PNG plots
 //! ([`plot`]). Everything in a report is deterministic except the measured times.
 
+pub mod atmosphere;
 pub mod compression;
 pub mod inputs;
 pub mod plot;

@@ -1,11 +1,11 @@
-//! `relume-bake study radiosity|compression|terrain`: the speed/accuracy sweeps of docs/algorithms.md §7.
+//! `relume-bake study radiosity|compression|terrain|atmosphere`: the speed/accuracy sweeps of docs/algorithms.md §7.
 //! Thin: resolve the input (defaults: the bundled Cornell box and Puget Sound), pick the full or
 //! quick configuration with the command line's overrides, run `relume::study`, write the report.
 
 use crate::ui::Ui;
 use clap::{Args, Subcommand};
 use relume::error::exit;
-use relume::study::{self, compression, inputs, radiosity, report, terrain, Study};
+use relume::study::{self, atmosphere, compression, inputs, radiosity, report, terrain, Study};
 use relume::Result;
 use std::path::PathBuf;
 
@@ -31,6 +31,15 @@ pub enum Which {
     /// Hard shadows (exact vs accelerated), the min/max mipmap, soft shadows (every method vs exhaustive)
     #[command(after_help = STUDY_HELP)]
     Terrain(TerrainArgs),
+    /// In-scattering error of the seed fog and Hillaire's tables against sun elevation
+    #[command(after_help = STUDY_HELP)]
+    Atmosphere(AtmosphereArgs),
+}
+
+#[derive(Args)]
+pub struct AtmosphereArgs {
+    #[command(flatten)]
+    pub common: Common,
 }
 
 #[derive(Args)]
@@ -157,6 +166,7 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
         Which::Radiosity(a) => (&a.common.out, a.common.quick),
         Which::Compression(a) => (&a.common.out, a.common.quick),
         Which::Terrain(a) => (&a.common.out, a.common.quick),
+        Which::Atmosphere(a) => (&a.common.out, a.common.quick),
     };
     // Refuse an unusable output path before minutes of work.
     report::prepare_dir(out)?;
@@ -223,6 +233,15 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
                 );
             }
             Study::new("terrain", name, quick, terrain::run(&map, &cfg, ui)?)
+        }
+        Which::Atmosphere(_) => {
+            let cfg = if quick {
+                atmosphere::AtmosphereConfig::quick()
+            } else {
+                atmosphere::AtmosphereConfig::full()
+            };
+            let input = "Earth's air (Atmosphere::earth), eye at 1.5 km".to_string();
+            Study::new("atmosphere", input, quick, atmosphere::run(&cfg))
         }
     };
     study::report::write(&mut study, out)?;
