@@ -125,6 +125,9 @@ docs-images: build
 	$(BAKE) -q study compression --out $(DOCS_OUT)/study/compression
 	$(BAKE) -q study terrain --sizes 512,1024,2048 --elevations 5,30 --soft-elevations 2,5 \
 	    --soft-rows 64 --out $(DOCS_OUT)/study/terrain
+	$(BAKE) -q study atmosphere --out $(DOCS_OUT)/study/atmosphere
+	cp $(DOCS_OUT)/study/atmosphere/atmosphere_error_vs_elevation.png \
+	    docs/images/study-atmosphere-error-vs-elevation.png
 	for f in radiosity/radiosity_patches_error_vs_time radiosity/radiosity_estimator_error_vs_time \
 	         radiosity/radiosity_bounces_error_vs_time compression/compression_reorder_error_vs_time \
 	         compression/compression_encoding_error_vs_bytes terrain/terrain_hard_shadows_time_vs_pixels \
@@ -198,11 +201,12 @@ bench: build
 	$(CARGO) bench --locked
 
 ## Speed/accuracy sweeps (docs/algorithms.md §7, docs/study.md): study.json, study.md and PNG plots in
-## out/study/{radiosity,compression,terrain}/. Add QUICK=1 for the small sizes (seconds).
+## out/study/{radiosity,compression,terrain,atmosphere}/. Add QUICK=1 for the small sizes (seconds).
 study: build
 	$(BAKE) study radiosity $(if $(QUICK),--quick) --out out/study/radiosity
 	$(BAKE) study compression $(if $(QUICK),--quick) --out out/study/compression
 	$(BAKE) study terrain $(if $(QUICK),--quick) --out out/study/terrain
+	$(BAKE) study atmosphere $(if $(QUICK),--quick) --out out/study/atmosphere
 
 ci: lint test
 
