@@ -86,6 +86,12 @@ fn main() {
                     "horizon maps, hypsometric tint (no themes)",
                     Shadows::Horizon,
                 ),
+                ("horizon maps, themes, air: none", Shadows::Horizon),
+                (
+                    "horizon maps, themes, air: fog per vertex",
+                    Shadows::Horizon,
+                ),
+                ("horizon maps, themes, air: fog per pixel", Shadows::Horizon),
                 ("soft shadows", Shadows::Soft),
             ],
         ),

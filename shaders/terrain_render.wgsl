@@ -30,6 +30,11 @@ struct TerrainFrame {
 }
 @group(0) @binding(0) var<uniform> frame: TerrainFrame;
 
+// Pipeline constants (gpu::terrain_pipelines makes one pipeline per combination): code a frame
+// does not use is compiled out, as a software rasteriser runs both sides of a branch.
+override THEMES: bool = true;
+override HILLAIRE: bool = true;
+
 struct VOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) texel: vec2<f32>,
@@ -137,7 +142,7 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
         }
     }
     var albedo: vec3<f32>;
-    if ((frame.flags & 16u) != 0u) {
+    if (THEMES && (frame.flags & 16u) != 0u) {
         albedo = theme_albedo(tp, footprint);
     } else {
         let h = height_at(col, row);
@@ -151,7 +156,7 @@ fn fs_main(v: VOut) -> @location(0) vec4<f32> {
         } else if (frame.model == 2u) {
             let f = seed_fog(v.world);
             rgb = rgb * f[1] + f[0];
-        } else if (frame.model == 3u) {
+        } else if (HILLAIRE && frame.model == 3u) {
             let to_p = v.world - frame.eye.xyz;
             let s = length(to_p);
             let m = aerial_perspective(to_p / max(s, 1e-6), s * 1e-3);

@@ -130,6 +130,8 @@ fn shared_structs() -> Vec<Shared> {
             "sun": field!(ShadeFrameU, sun),
             "background": field!(ShadeFrameU, background),
             "size": field!(ShadeFrameU, size),
+            "eye": field!(ShadeFrameU, eye),
+            "projection": field!(ShadeFrameU, projection),
         }),
         shared!("freeform.wgsl", "Leaf", GpuLeaf {
             "base": field!(GpuLeaf, base),

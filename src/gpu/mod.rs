@@ -17,6 +17,7 @@ pub mod readback;
 pub mod render_target;
 pub mod terrain_air;
 mod terrain_buffers;
+mod terrain_pipelines;
 pub mod terrain_renderer;
 pub mod themes;
 pub mod timing;

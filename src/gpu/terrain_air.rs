@@ -91,9 +91,9 @@ pub fn air_frame(
     }
 }
 
-/// The group-3 bindings each entry point reads (automatic layouts hold only those): the
-/// terrain its aerial volume, the sky its sky view, both the parameters.
-const TERRAIN_USES: &[usize] = &[0, 2];
+/// The group-3 bindings of the terrain's explicit layout (all three) and of the sky
+/// pipeline's automatic one (only what it reads: the parameters and the sky view).
+const TERRAIN_USES: &[usize] = &[0, 1, 2];
 const SKY_USES: &[usize] = &[0, 1];
 
 /// A bind group of `layout` with bindings `uses` of (parameters, sky view, aerial volume).
@@ -131,12 +131,12 @@ pub struct TerrainAir {
 }
 
 impl TerrainAir {
-    /// The sky pipeline over `module`, group 3 of `terrain` bound to placeholders until the
-    /// first Hillaire frame; `frame` is the terrain's frame uniform.
+    /// The sky pipeline over `module`, group 3 (of layout `terrain`) bound to placeholders
+    /// until the first Hillaire frame; `frame` is the terrain's frame uniform.
     pub fn new(
         gpu: &Gpu,
         module: &wgpu::ShaderModule,
-        terrain: &wgpu::RenderPipeline,
+        terrain: &wgpu::BindGroupLayout,
         frame: &wgpu::Buffer,
     ) -> TerrainAir {
         let sky_pipeline = gpu
@@ -174,7 +174,7 @@ impl TerrainAir {
             compute::storage(gpu, "aerial placeholder", &[0u32; 4]),
         ];
         let p = [&placeholder[0], &placeholder[1], &placeholder[2]];
-        let terrain_group = bind(gpu, &terrain.get_bind_group_layout(3), TERRAIN_USES, p);
+        let terrain_group = bind(gpu, terrain, TERRAIN_USES, p);
         let sky_group = bind(gpu, &sky_pipeline.get_bind_group_layout(3), SKY_USES, p);
         let sky_frame = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sky frame"),
@@ -208,7 +208,7 @@ impl TerrainAir {
     pub fn prepare_tables(
         &mut self,
         gpu: &Gpu,
-        terrain: &wgpu::RenderPipeline,
+        terrain: &wgpu::BindGroupLayout,
         sun: &Sun,
         eye_altitude: f64,
         range: f64,
@@ -225,7 +225,7 @@ impl TerrainAir {
             None => {
                 let t = AtmosphereTables::build(gpu, &p)?;
                 let b = [&t.params, &t.sky_view, &t.aerial];
-                self.terrain_group = bind(gpu, &terrain.get_bind_group_layout(3), TERRAIN_USES, b);
+                self.terrain_group = bind(gpu, terrain, TERRAIN_USES, b);
                 self.sky_group = bind(
                     gpu,
                     &self.sky_pipeline.get_bind_group_layout(3),

@@ -3,9 +3,10 @@
 //! `terrain::relief::shadow_mask`) and the terrain frame (`terrain_render.wgsl`, tested against
 //! `render::terrain_shading`).
 
-use super::render_target::{RenderTarget, DEPTH_FORMAT, TARGET_FORMAT};
+use super::render_target::RenderTarget;
 use super::terrain_air::{air_frame, TerrainAir};
 use super::terrain_buffers::{grid_mesh, TerrainBuffers};
+use super::terrain_pipelines::TerrainPipelines;
 use super::themes::ThemeGpu;
 use super::{compute, timing::PassTimer, Gpu};
 use crate::error::{Error, Result};
@@ -95,7 +96,7 @@ pub struct TerrainRenderer {
     mask_groups: [wgpu::BindGroup; 2],
     mask_params: wgpu::Buffer,
     mask_out: wgpu::Buffer,
-    render_pipeline: wgpu::RenderPipeline,
+    pipelines: TerrainPipelines,
     render_groups: [wgpu::BindGroup; 2],
     frame: wgpu::Buffer,
     grid: wgpu::Buffer,
@@ -180,47 +181,7 @@ impl TerrainRenderer {
             terrain_entries(&mask_pipeline.get_bind_group_layout(1)),
         ];
 
-        let module = gpu.shader("terrain_render.wgsl")?;
-        let render_pipeline = gpu
-            .device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("terrain"),
-                layout: None,
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: 8,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &[wgpu::VertexAttribute {
-                            format: wgpu::VertexFormat::Float32x2,
-                            offset: 0,
-                            shader_location: 0,
-                        }],
-                    })],
-                },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(TARGET_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+        let pipelines = TerrainPipelines::new(gpu)?;
         let frame = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("terrain frame"),
             size: std::mem::size_of::<TerrainFrame>() as u64,
@@ -229,19 +190,16 @@ impl TerrainRenderer {
         });
         let g0 = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("terrain frame"),
-            layout: &render_pipeline.get_bind_group_layout(0),
+            layout: &pipelines.layouts[0],
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
                 resource: frame.as_entire_binding(),
             }],
         });
-        let render_groups = [
-            g0,
-            terrain_entries(&render_pipeline.get_bind_group_layout(1)),
-        ];
-        let air = TerrainAir::new(gpu, &module, &render_pipeline, &frame);
+        let render_groups = [g0, terrain_entries(&pipelines.layouts[1])];
+        let air = TerrainAir::new(gpu, &pipelines.module, &pipelines.layouts[3], &frame);
         let themes = ThemeGpu::upload(gpu, &crate::theme::ThemeSet::placeholder());
-        let theme_group = themes.bind(gpu, &render_pipeline.get_bind_group_layout(2));
+        let theme_group = themes.bind(gpu, &pipelines.layouts[2]);
 
         let step = grid_step
             .unwrap_or_else(|| (map.width.max(map.height) as u32).div_ceil(MAX_GRID))
@@ -260,7 +218,7 @@ impl TerrainRenderer {
             mask_groups,
             mask_params,
             mask_out,
-            render_pipeline,
+            pipelines,
             render_groups,
             frame,
             grid,
@@ -331,9 +289,7 @@ impl TerrainRenderer {
         self.mask_groups[1] = self
             .buffers
             .bind(gpu, &self.mask_pipeline.get_bind_group_layout(1));
-        self.render_groups[1] = self
-            .buffers
-            .bind(gpu, &self.render_pipeline.get_bind_group_layout(1));
+        self.render_groups[1] = self.buffers.bind(gpu, &self.pipelines.layouts[1]);
         self.params_cpu.has_horizon = 1;
         self.set_sun(gpu, self.sun);
         Ok(())
@@ -466,8 +422,13 @@ impl TerrainRenderer {
             let extent = (self.map_size.0 as f64 * self.cell[0] as f64)
                 .hypot(self.map_size.1 as f64 * self.cell[1] as f64);
             let range = (2.0 * extent).max(50_000.0);
-            self.air
-                .prepare_tables(gpu, &self.render_pipeline, &self.sun, eye_altitude, range)?;
+            self.air.prepare_tables(
+                gpu,
+                &self.pipelines.layouts[3],
+                &self.sun,
+                eye_altitude,
+                range,
+            )?;
         }
         let f = TerrainFrame {
             view_proj: view_proj.to_cols_array(),
@@ -499,7 +460,11 @@ impl TerrainRenderer {
         gpu.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&f));
         let mut pass = self.target.begin_pass(enc, "terrain", s.background, timer);
-        pass.set_pipeline(&self.render_pipeline);
+        let themed = s.themes && self.has_themes;
+        pass.set_pipeline(
+            self.pipelines
+                .get(gpu, themed, s.atmosphere == Model::Hillaire),
+        );
         pass.set_bind_group(0, &self.render_groups[0], &[]);
         pass.set_bind_group(1, &self.render_groups[1], &[]);
         pass.set_bind_group(2, &self.theme_group, &[]);
@@ -517,9 +482,7 @@ impl TerrainRenderer {
     /// the hypsometric tint.
     pub fn set_themes(&mut self, gpu: &Gpu, set: &crate::theme::ThemeSet) {
         self.themes = ThemeGpu::upload(gpu, set);
-        self.theme_group = self
-            .themes
-            .bind(gpu, &self.render_pipeline.get_bind_group_layout(2));
+        self.theme_group = self.themes.bind(gpu, &self.pipelines.layouts[2]);
         self.has_themes = true;
     }
 
