@@ -72,23 +72,25 @@ impl ThemeProjection {
     pub fn check(&self) -> std::result::Result<(), String> {
         match *self {
             ThemeProjection::Planar { min, max } => {
-                if !(min.iter().chain(&max).all(|v| v.is_finite())
-                    && min[0] < max[0]
-                    && min[1] < max[1])
-                {
-                    return Err(format!(
+                let finite = min.iter().chain(&max).all(|v| v.is_finite());
+                if finite && min[0] < max[0] && min[1] < max[1] {
+                    Ok(())
+                } else {
+                    Err(format!(
                         "themes: a planar projection needs finite min < max, got {min:?}..{max:?}"
-                    ));
+                    ))
                 }
             }
-            ThemeProjection::Spherical { centre } if !centre.iter().all(|v| v.is_finite()) => {
-                return Err(format!(
-                    "themes: the sphere's centre must be finite, got {centre:?}"
-                ));
+            ThemeProjection::Spherical { centre } => {
+                if centre.iter().all(|v| v.is_finite()) {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "themes: the sphere's centre must be finite, got {centre:?}"
+                    ))
+                }
             }
-            _ => {}
         }
-        Ok(())
     }
 
     /// The f32 view the shaders use: (kind 1 planar / 2 spherical, four numbers).
