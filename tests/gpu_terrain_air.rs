@@ -14,9 +14,10 @@ use relume::atmosphere::fog::FogParams;
 use relume::atmosphere::lut::Luts;
 use relume::atmosphere::twin::AtmosphereGpu;
 use relume::atmosphere::{Atmosphere, Model};
-use relume::gpu::terrain_air::{air_frame, sun_world, SKY};
+use relume::gpu::terrain_air::{air_frame, SKY};
 use relume::gpu::terrain_renderer::TerrainRenderer;
 use relume::gpu::timing::PassTimer;
+use relume::gpu::Gpu;
 use relume::heightmap::HeightMap;
 use relume::render::camera::Camera;
 use relume::render::terrain_shading::{tint, TerrainSettings};
@@ -28,8 +29,7 @@ const H: u32 = 120;
 const CELL: f64 = 1000.0;
 
 /// (differing pixels beyond 2/255, compared pixels, worst difference) of `model`.
-fn compare(model: Model, sun: Sun) -> (usize, usize, u8) {
-    let gpu = gpu().expect("checked by the caller");
+fn compare(gpu: &Gpu, model: Model, sun: Sun) -> (usize, usize, u8) {
     let map = HeightMap {
         width: 64,
         height: 64,
@@ -38,8 +38,8 @@ fn compare(model: Model, sun: Sun) -> (usize, usize, u8) {
         height_scale: 1.0,
     };
     let mip = MinMaxMipmap::build(&map);
-    let mut r = TerrainRenderer::new(&gpu, &map, &mip, W, H, Some(1)).unwrap();
-    r.set_sun(&gpu, sun);
+    let mut r = TerrainRenderer::new(gpu, &map, &mip, W, H, Some(1)).unwrap();
+    r.set_sun(gpu, sun);
     let s = TerrainSettings {
         shadows: false,
         themes: false,
@@ -57,18 +57,18 @@ fn compare(model: Model, sun: Sun) -> (usize, usize, u8) {
         far: 400_000.0,
     };
     let vp = camera.view_projection(W, H);
-    let mut timer = PassTimer::new(&gpu, 2);
+    let mut timer = PassTimer::new(gpu, 2);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    r.record(&gpu, &mut enc, vp, camera.eye, &s, &mut timer)
+    r.record(gpu, &mut enc, vp, camera.eye, &s, &mut timer)
         .unwrap();
     gpu.queue.submit([enc.finish()]);
-    let img = r.target.read_image(&gpu).unwrap();
+    let img = r.target.read_image(gpu).unwrap();
 
     // The CPU frame.
     let atm = Atmosphere::earth();
     let eye = camera.eye.as_dvec3();
     let air = air_frame(&atm, model, &sun, eye.y, 0.0, s.sun_strength);
-    let sw = sun_world(&sun);
+    let sw = sun.toward_y_up_f64();
     let fog = FogParams::new(&atm, eye.y, sw, false);
     let luts = (model == Model::Hillaire).then(|| {
         let extent = (64.0 * CELL).hypot(64.0 * CELL);
@@ -147,9 +147,7 @@ fn compare(model: Model, sun: Sun) -> (usize, usize, u8) {
 
 #[test]
 fn terrain_frames_through_the_air_match_a_cpu_rendering() {
-    if gpu().is_none() {
-        return;
-    }
+    let Some(gpu) = gpu() else { return };
     for (model, sun) in [
         (Model::FogPerPixel, Sun::new(120.0, 25.0).unwrap()),
         // Per vertex against the per-pixel reference: the fog interpolated over 1 km cells.
@@ -157,7 +155,7 @@ fn terrain_frames_through_the_air_match_a_cpu_rendering() {
         (Model::Hillaire, Sun::new(120.0, 25.0).unwrap()),
         (Model::Hillaire, Sun::new(300.0, 3.0).unwrap()),
     ] {
-        let (off, n, worst) = compare(model, sun);
+        let (off, n, worst) = compare(&gpu, model, sun);
         eprintln!(
             "{model:?}, sun {}/{}: {off} of {n} pixels differ by more than 2/255, worst {worst}/255",
             sun.azimuth_deg, sun.elevation_deg

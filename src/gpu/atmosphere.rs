@@ -175,16 +175,7 @@ impl AtmosphereTables {
 
     /// The group-3 layout entries of `atmosphere_lookup.wgsl`, visible to `visibility`.
     pub fn layout_entries(visibility: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 3] {
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let entry = |binding, ty| compute::buffer_entry(binding, visibility, ty);
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
         [
             entry(0, wgpu::BufferBindingType::Uniform),

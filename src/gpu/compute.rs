@@ -42,6 +42,24 @@ pub fn output(gpu: &Gpu, label: &str, bytes: u64) -> wgpu::Buffer {
     })
 }
 
+/// A bind-group layout entry for a buffer at `binding` (no dynamic offset, any size).
+pub fn buffer_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
 /// A compute pipeline for `entry` of kernel `shader` with an automatic layout.
 pub fn pipeline(gpu: &Gpu, shader: &str, entry: &str) -> Result<wgpu::ComputePipeline> {
     let module = gpu.shader(shader)?;

@@ -17,7 +17,6 @@ use crate::atmosphere::twin::AtmosphereGpu;
 use crate::atmosphere::{eye_position, reference, Atmosphere, Model};
 use crate::error::Result;
 use crate::terrain::sun::Sun;
-use glam::DVec3;
 
 /// The air's fields of the `TerrainFrame` uniform.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -34,12 +33,6 @@ pub struct AirFrame {
 /// The sky (ambient) term of the terrain's lighting.
 pub const SKY: f32 = 0.15;
 
-/// Toward the sun in the frame's world (x east, y up, z south).
-pub fn sun_world(sun: &Sun) -> DVec3 {
-    let [x, y, z] = sun.direction();
-    DVec3::new(x, z, -y)
-}
-
 /// The air's uniform fields for `model` with the eye at `eye_altitude` m, the terrain's mean
 /// altitude `ground_altitude` m, sun strength `strength`.
 pub fn air_frame(
@@ -50,7 +43,7 @@ pub fn air_frame(
     ground_altitude: f64,
     strength: f32,
 ) -> AirFrame {
-    let s = sun_world(sun);
+    let s = sun.toward_y_up_f64();
     let f = FogParams::new(atm, eye_altitude, s, false);
     let km = |v: [f64; 3], w: f64| {
         [
@@ -217,7 +210,7 @@ impl TerrainAir {
         let p = AtmosphereGpu::new(
             &self.atmosphere,
             eye_altitude.round().max(1.0),
-            sun_world(sun),
+            sun.toward_y_up_f64(),
             range,
         );
         match &mut self.tables {

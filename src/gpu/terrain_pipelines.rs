@@ -9,6 +9,7 @@
 //! GPU skips a uniform branch either way.
 
 use super::atmosphere::AtmosphereTables;
+use super::compute::buffer_entry;
 use super::render_target::{DEPTH_FORMAT, TARGET_FORMAT};
 use super::Gpu;
 use crate::error::Result;
@@ -20,23 +21,6 @@ pub(super) struct TerrainPipelines {
     layout: wgpu::PipelineLayout,
     pub module: wgpu::ShaderModule,
     variants: [Option<wgpu::RenderPipeline>; 4],
-}
-
-fn buffer_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    ty: wgpu::BufferBindingType,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 impl TerrainPipelines {

@@ -91,6 +91,14 @@ pub fn map_view(
     themes: Option<(&ThemeSet, u32)>,
 ) -> image::RgbaImage {
     let lookup = themes.filter(|_| s.themes).map(|(t, f)| t.lookup(f));
+    // The index map spans the height map: texel centre → index texels.
+    let scale = lookup.as_ref().map_or([1.0; 2], |l| {
+        let base = &l.set.index.levels[0];
+        [
+            base.width as f32 / map.width as f32,
+            base.height as f32 / map.height as f32,
+        ]
+    });
     let lam = lambert(map, sun);
     let k = k_shadow(sun, s.k_dark as f64, s.k_bright as f64) as f32;
     let (lo, hi) = map.min_max();
@@ -100,15 +108,11 @@ pub fn map_view(
         let sh = if s.shadows { shadow[i] } else { 0.0 };
         let albedo = match &lookup {
             Some(l) => {
-                // The index map spans the height map: texel centre → index texels.
-                let base = &l.set.index.levels[0];
-                let sx = base.width as f32 / map.width as f32;
-                let sy = base.height as f32 / map.height as f32;
                 let p = [
-                    ((i % map.width) as f32 + 0.5) * sx,
-                    ((i / map.width) as f32 + 0.5) * sy,
+                    ((i % map.width) as f32 + 0.5) * scale[0],
+                    ((i / map.width) as f32 + 0.5) * scale[1],
                 ];
-                l.albedo(p, sx.max(sy))
+                l.albedo(p, scale[0].max(scale[1]))
             }
             None => tint((map.heights[i] - lo) / span),
         };

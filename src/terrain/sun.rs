@@ -50,6 +50,13 @@ impl Sun {
         [sa * ce, ca * ce, se]
     }
 
+    /// The same direction in f64: toward the sun in a y-up world whose north is −z (x east, z
+    /// south; the terrain frame's world).
+    pub fn toward_y_up_f64(&self) -> glam::DVec3 {
+        let [x, y, z] = self.direction();
+        glam::DVec3::new(x, z, -y)
+    }
+
     /// f32 view for a y-up scene whose north is −z (the player's mesh scenes):
     /// (sin az · cos el, sin el, −cos az · cos el), evaluated in f32.
     pub fn toward_y_up(&self) -> glam::Vec3 {
