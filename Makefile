@@ -125,7 +125,7 @@ docs-images: build
 	$(BAKE) -q study compression --out $(DOCS_OUT)/study/compression
 	$(BAKE) -q study terrain --sizes 512,1024,2048 --elevations 5,30 --soft-elevations 2,5 \
 	    --soft-rows 64 --out $(DOCS_OUT)/study/terrain
-	$(BAKE) -q study atmosphere --out $(DOCS_OUT)/study/atmosphere
+	$(BAKE) -q study atmosphere --paths 40000 --out $(DOCS_OUT)/study/atmosphere
 	cp $(DOCS_OUT)/study/atmosphere/atmosphere_error_vs_elevation.png \
 	    docs/images/study-atmosphere-error-vs-elevation.png
 	for f in radiosity/radiosity_patches_error_vs_time radiosity/radiosity_estimator_error_vs_time \

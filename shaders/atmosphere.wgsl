@@ -88,8 +88,10 @@ struct SunLight {
 fn sun_light(x: vec3<f32>, sun: vec3<f32>) -> SunLight {
     let r = length(x);
     let mu_s = dot(x, sun) / r;
+    // Below the local horizon the planet hides the sun (twin: lut::sun_light).
+    let q = atmo.radii.x / max(r, atmo.radii.x);
     var shadow = 1.0;
-    if (ray_sphere_nearest(x, sun, atmo.radii.x) >= 0.0) {
+    if (mu_s < -sqrt(max(1.0 - q * q, 0.0))) {
         shadow = 0.0;
     }
     return SunLight(shadow, atmo_transmittance(r, mu_s), mu_s);
@@ -128,13 +130,27 @@ fn build_multi_scattering(@builtin(global_invocation_id) id: vec3<u32>) {
     let o = vec3<f32>(0.0, r, 0.0);
     let sun = vec3<f32>(sqrt(max(1.0 - mu_s * mu_s, 0.0)), mu_s, 0.0);
     let iso = 1.0 / (4.0 * PI);
+    // Cosine of the horizon's zenith angle (twin: horizon_cosine).
+    let q = atmo.radii.x / max(r, atmo.radii.x);
+    let mu_h = -sqrt(max(1.0 - q * q, 0.0));
+    let half = MULTI_BANDS / 2u;
     var l2 = vec3<f32>(0.0);
     var fms = vec3<f32>(0.0);
-    let side = f32(MULTI_DIRECTIONS);
-    for (var a = 0u; a < MULTI_DIRECTIONS; a++) {
-        for (var bb = 0u; bb < MULTI_DIRECTIONS; bb++) {
-            let theta = 2.0 * PI * (f32(a) + 0.5) / side;
-            let cos_phi = 1.0 - 2.0 * (f32(bb) + 0.5) / side;
+    for (var a = 0u; a < MULTI_AZIMUTHS; a++) {
+        let theta = 2.0 * PI * (f32(a) + 0.5) / f32(MULTI_AZIMUTHS);
+        for (var bb = 0u; bb < MULTI_BANDS; bb++) {
+            // Band bb: half above the horizon, half below, crowded toward it (twin: band).
+            var kb = bb - half;
+            var span = 1.0 + mu_h;
+            var sign = -1.0;
+            if (bb < half) {
+                kb = half - 1u - bb;
+                span = 1.0 - mu_h;
+                sign = 1.0;
+            }
+            let sb = (f32(kb) + 0.5) / f32(half);
+            let cos_phi = mu_h + sign * span * sb * sb;
+            let share = span * sb / f32(half) / f32(MULTI_AZIMUTHS);
             let sin_phi = sqrt(max(1.0 - cos_phi * cos_phi, 0.0));
             let dir = vec3<f32>(cos(theta) * sin_phi, cos_phi, sin(theta) * sin_phi);
             let t_ground = ray_sphere_nearest(o, dir, atmo.radii.x);
@@ -143,12 +159,17 @@ fn build_multi_scattering(@builtin(global_invocation_id) id: vec3<u32>) {
             if (t_ground >= 0.0) {
                 t_max = t_ground;
             }
-            let dt = t_max / f32(STEPS_MULTI);
             var l = vec3<f32>(0.0);
             var f = vec3<f32>(0.0);
             var thr = vec3<f32>(1.0);
             for (var k = 0u; k < STEPS_MULTI; k++) {
-                let x = o + dir * ((f32(k) + 0.5) * dt);
+                // Quadratic steps, crowded toward the point (twin: step_span).
+                let u0 = f32(k) / f32(STEPS_MULTI);
+                let u1 = f32(k + 1u) / f32(STEPS_MULTI);
+                let t0 = u0 * u0 * t_max;
+                let t1 = u1 * u1 * t_max;
+                let dt = t1 - t0;
+                let x = o + dir * (0.5 * (t0 + t1));
                 let m = atmo_medium(length(x) - atmo.radii.x);
                 let sl = sun_light(x, sun);
                 let scat = m.rayleigh + m.mie;
@@ -166,12 +187,10 @@ fn build_multi_scattering(@builtin(global_invocation_id) id: vec3<u32>) {
                 let c = clamp(dot(up, sun), 0.0, 1.0);
                 l += thr * sl.transmittance * atmo.ground_albedo.xyz * (c / PI);
             }
-            l2 += l;
-            fms += f;
+            l2 += l * share;
+            fms += f * share;
         }
     }
-    l2 /= side * side;
-    fms /= side * side;
     atmo_out[n] = vec4<f32>(l2 / (vec3<f32>(1.0) - fms), 1.0);
 }
 
@@ -241,8 +260,20 @@ fn build_aerial(@builtin(global_invocation_id) id: vec3<u32>) {
     let ang = sky_view_angles(atmo_eye().y, atmo.radii.x, atmo_unit_of(i, AERIAL_N), atmo_unit_of(j, AERIAL_N));
     let dir = frame_dir(ang.x, ang.y);
     let w = atmo_unit_of(k, AERIAL_N);
-    let s = min(atmo.radii.w * w * w, exit_distance(dir));
-    let m = atmo_march(dir, s, STEPS_AERIAL, false);
+    // A cell under the ground is lifted onto it (twin: lut::aerial_target).
+    let o = atmo_eye();
+    var target_dir = dir;
+    var s = atmo.radii.w * w * w;
+    let t_ground = ray_sphere_nearest(o, dir, atmo.radii.x);
+    if (t_ground < 0.0 || s <= t_ground) {
+        s = min(s, exit_distance(dir));
+    } else {
+        let x = o + dir * s;
+        let v = x * ((atmo.radii.x + 1e-3) / length(x)) - o;
+        s = length(v);
+        target_dir = v / max(s, 1e-12);
+    }
+    let m = atmo_march(target_dir, s, STEPS_AERIAL, false);
     atmo_out[2u * n] = vec4<f32>(m.inscatter, 0.0);
     atmo_out[2u * n + 1u] = vec4<f32>(m.transmittance, 0.0);
 }

@@ -27,8 +27,10 @@ const SKY_H: u32 = 108u;
 const AERIAL_N: u32 = 32u;
 const STEPS_TRANSMITTANCE: u32 = 40u;
 const STEPS_MULTI: u32 = 20u;
-// Directions per axis of the multiple-scattering sphere (twin.rs MULTI_DIRECTIONS).
-const MULTI_DIRECTIONS: u32 = 8u;
+// The multiple-scattering sphere: azimuths x zenith-cosine bands (twin.rs MULTI_AZIMUTHS,
+// MULTI_BANDS; the bands split at the horizon and crowd toward it, lut.rs band).
+const MULTI_AZIMUTHS: u32 = 4u;
+const MULTI_BANDS: u32 = 16u;
 const STEPS_SKY: u32 = 30u;
 const STEPS_AERIAL: u32 = 20u;
 

@@ -2,10 +2,14 @@
 //! `shaders/atmosphere.wgsl` (same parameterisations, same quadrature, see `twin.rs`).
 //!
 //! - **Transmittance** T(r, μ) to the top of the air: 40 midpoint steps.
-//! - **Multiple scattering** Ψ_ms(r, μ_s) for unit illuminance: from 64 directions (8 × 8,
-//!   uniform on the sphere) the second-order light L₂ (isotropic phase, ground albedo lit by
-//!   the sun) and the transfer f_ms = ⟨∫T·σ_s⟩; Ψ_ms = L₂ / (1 − f_ms), the infinite series of
-//!   isotropic orders (paper §5.5).
+//! - **Multiple scattering** Ψ_ms(r, μ_s) for unit illuminance: from 64 directions the
+//!   second-order light L₂ (isotropic phase, ground albedo lit by the sun) and the transfer
+//!   f_ms = ⟨∫T·σ_s⟩; Ψ_ms = L₂ / (1 − f_ms), the infinite series of isotropic orders (paper
+//!   §5.5). The paper's 8 × 8 directions uniform on the sphere miss the radiance that peaks at
+//!   the horizon (grazing paths through the low Mie layer): L₂ came out 22 % low in red at 1.5 km
+//!   against a 32,768-direction quadrature. Here 4 azimuths × 16 zenith bands, split at the
+//!   horizon and crowded toward it, with steps crowded toward the point ([`band`]): within 2 %
+//!   of that quadrature from 0.1 to 20 km, at the same cost (`tests/atmosphere_orders.rs`).
 //! - **Sky view** L(θ, φ) at the eye: 30 steps (quadratic spacing) to the ground or the top;
 //!   single scattering (phase, T from the table, planet shadow) plus σ_s·Ψ_ms.
 //! - **Aerial perspective** (φ, θ, s): the same integrand over 20 uniform steps from the eye to
@@ -73,7 +77,10 @@ pub fn multi_scattering(p: &AtmosphereGpu, tab: &[[f32; 4]], r: f32, mu_s: f32) 
 fn sun_light(p: &AtmosphereGpu, trans: &[[f32; 4]], x: Vec3, sun: Vec3) -> (f32, Vec3, f32) {
     let r = x.length();
     let mu_s = x.dot(sun) / r;
-    let shadow = if ray_sphere_nearest(x, sun, p.ground()) >= 0.0 {
+    // The planet hides the sun below the local horizon: the same test as a ray–sphere hit
+    // toward the sun, but well conditioned near the ground (and defined under it, where an
+    // aerial cell's march may pass).
+    let shadow = if mu_s < horizon_cosine(p, r) {
         0.0
     } else {
         1.0
@@ -89,6 +96,7 @@ fn multi_direction(
     dir: Vec3,
     sun: Vec3,
     n: u32,
+    quadratic: bool,
 ) -> (Vec3, Vec3) {
     let t_ground = ray_sphere_nearest(o, dir, p.ground());
     let t_top = ray_sphere_nearest(o, dir, p.top());
@@ -97,11 +105,12 @@ fn multi_direction(
     } else {
         t_top.max(0.0)
     };
-    let dt = t_max / n as f32;
     let iso = 1.0 / (4.0 * std::f32::consts::PI);
     let (mut l, mut f, mut thr) = (Vec3::ZERO, Vec3::ZERO, Vec3::ONE);
     for k in 0..n {
-        let x = o + dir * ((k as f32 + 0.5) * dt);
+        let (t0, t1) = step_span(k, n, t_max, quadratic);
+        let dt = t1 - t0;
+        let x = o + dir * (0.5 * (t0 + t1));
         let (sr, sm, ext) = medium(p, x.length() - p.ground());
         let (shadow, ts, _) = sun_light(p, trans, x, sun);
         let scat = sr + sm;
@@ -122,22 +131,47 @@ fn multi_direction(
     (l, f)
 }
 
-/// The sampling of the multiple-scattering table: directions per axis (`side`² in all, uniform
-/// on the sphere) and raymarch steps per direction. [`MultiQuality::TWIN`] is what the WGSL
-/// kernel uses; others are CPU-only, for measuring the table's own resolution error.
+/// Step `k` of `n` over `[0, t_max]`: uniform, or quadratic (crowded toward 0).
+fn step_span(k: u32, n: u32, t_max: f32, quadratic: bool) -> (f32, f32) {
+    let (a, b) = (k as f32 / n as f32, (k + 1) as f32 / n as f32);
+    if quadratic {
+        (a * a * t_max, b * b * t_max)
+    } else {
+        (a * t_max, b * t_max)
+    }
+}
+
+/// The sampling of the multiple-scattering table: azimuths × zenith-cosine bands, raymarch
+/// steps per direction, and where they crowd. [`MultiQuality::TWIN`] is what the WGSL kernel
+/// uses; [`MultiQuality::PAPER`] is Hillaire's; others are CPU-only, for measuring the table's
+/// own error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MultiQuality {
-    pub side: usize,
+    pub azimuths: usize,
+    pub bands: usize,
     pub steps: u32,
     /// Hillaire's infinite isotropic series L₂/(1 − f_ms); false keeps order two (L₂) alone.
     pub all_orders: bool,
+    /// Bands split at the horizon and crowded toward it, steps crowded toward the point
+    /// ([`band`]); false: the paper's uniform bands and steps.
+    pub horizon: bool,
 }
 
 impl MultiQuality {
     pub const TWIN: MultiQuality = MultiQuality {
-        side: MULTI_DIRECTIONS,
+        azimuths: MULTI_AZIMUTHS,
+        bands: MULTI_BANDS,
         steps: STEPS[1],
         all_orders: true,
+        horizon: true,
+    };
+    /// The paper's sampling: 8 × 8 directions uniform on the sphere, 20 uniform steps.
+    pub const PAPER: MultiQuality = MultiQuality {
+        azimuths: 8,
+        bands: 8,
+        steps: 20,
+        all_orders: true,
+        horizon: false,
     };
 }
 
@@ -163,30 +197,68 @@ pub fn multi_scattering_texel_with(
     let mu_s = 2.0 * unit(i, w) - 1.0;
     let y = unit(j, h);
     let r = p.ground() + y * y * (p.top() - p.ground());
+    quad(multi_scattering_at(p, trans, r, mu_s, q), 1.0)
+}
+
+/// Ψ_ms at radius `r` for sun zenith cosine `mu_s`, computed (not looked up) with the
+/// sampling `q`.
+pub fn multi_scattering_at(
+    p: &AtmosphereGpu,
+    trans: &[[f32; 4]],
+    r: f32,
+    mu_s: f32,
+    q: MultiQuality,
+) -> Vec3 {
     let o = Vec3::new(0.0, r, 0.0);
     let sun = Vec3::new((1.0 - mu_s * mu_s).max(0.0).sqrt(), mu_s, 0.0);
+    let mu_h = horizon_cosine(p, r);
+    // Sums weighted by each direction's share of the sphere: averages over it (the isotropic
+    // phase is inside L₂ already; f_ms is ∫T·σ_s averaged over directions).
     let (mut l2, mut fms) = (Vec3::ZERO, Vec3::ZERO);
-    let side = q.side;
-    for a in 0..side {
-        for b in 0..side {
-            let theta = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / side as f32;
-            let cos_phi = 1.0 - 2.0 * (b as f32 + 0.5) / side as f32;
+    for a in 0..q.azimuths {
+        let theta = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / q.azimuths as f32;
+        for b in 0..q.bands {
+            let (cos_phi, share) = band(b, q.bands, mu_h, q.horizon);
             let sin_phi = (1.0 - cos_phi * cos_phi).max(0.0).sqrt();
             let dir = Vec3::new(theta.cos() * sin_phi, cos_phi, theta.sin() * sin_phi);
-            let (l, f) = multi_direction(p, trans, o, dir, sun, q.steps);
-            l2 += l;
-            fms += f;
+            let (l, f) = multi_direction(p, trans, o, dir, sun, q.steps, q.horizon);
+            let w = share / q.azimuths as f32;
+            l2 += l * w;
+            fms += f * w;
         }
     }
-    // Averages over the sphere (the isotropic phase is inside L₂ already; f_ms is ∫T·σ_s
-    // averaged over directions, i.e. with the isotropic phase times 4π).
-    let count = (side * side) as f32;
-    l2 /= count;
-    fms /= count;
     if !q.all_orders {
-        return quad(l2, 1.0);
+        return l2;
     }
-    quad(l2 / (Vec3::ONE - fms), 1.0)
+    l2 / (Vec3::ONE - fms)
+}
+
+/// Band `b` of `bands` in cos φ (the direction's zenith cosine): its node and its share of
+/// the sphere. Uniform: midpoints of equal bands. Crowded (`horizon`): the first half spans
+/// [μ_h, 1] above the horizon (zenith cosine `mu_h`), the second [−1, μ_h] below it, each with
+/// cos φ = μ_h ± span·s² at the midpoints s of equal steps of [0, 1] (share span·s / half):
+/// the radiance of grazing directions, through the most air, is where the nodes are.
+pub fn band(b: usize, bands: usize, mu_h: f32, horizon: bool) -> (f32, f32) {
+    if !horizon {
+        return (
+            1.0 - 2.0 * (b as f32 + 0.5) / bands as f32,
+            1.0 / bands as f32,
+        );
+    }
+    let half = bands / 2;
+    let (k, up) = if b < half {
+        (half - 1 - b, true)
+    } else {
+        (b - half, false)
+    };
+    let s = (k as f32 + 0.5) / half as f32;
+    let span = if up { 1.0 - mu_h } else { 1.0 + mu_h };
+    let c = if up {
+        mu_h + span * s * s
+    } else {
+        mu_h - span * s * s
+    };
+    (c, span * s / half as f32)
 }
 
 /// The sky / aerial raymarch from the eye along `dir` over `[0, t_max]` with `n` steps
@@ -209,12 +281,7 @@ pub fn march(
     let e = v3(p.sun_illuminance);
     let (mut l, mut thr) = (Vec3::ZERO, Vec3::ONE);
     for k in 0..n {
-        let (a, b) = (k as f32 / n as f32, (k + 1) as f32 / n as f32);
-        let (t0, t1) = if quadratic {
-            (a * a * t_max, b * b * t_max)
-        } else {
-            (a * t_max, b * t_max)
-        };
+        let (t0, t1) = step_span(k, n, t_max, quadratic);
         let dt = t1 - t0;
         let x = o + dir * (0.5 * (t0 + t1));
         let r = x.length();
@@ -283,9 +350,27 @@ pub fn aerial_texels(
     let (theta, phi) = sky_view_angles(p, p.eye().y, unit(i, nx), unit(j, ny));
     let dir = frame_dir(p, theta, phi);
     let w = unit(k, nz);
-    let s = (p.radii[3] * w * w).min(exit_distance(p, dir));
+    let (dir, s) = aerial_target(p, dir, p.radii[3] * w * w);
     let (l, t) = march(p, trans, ms, dir, s, STEPS[3], false);
     [quad(l, 0.0), quad(t, 0.0)]
+}
+
+/// The segment an aerial cell marches: from the eye along `dir` for `s` km, but a cell whose
+/// point lies under the ground is lifted onto it (1 m above, straight up) and marched to
+/// there, after Hillaire's implementation. Clamping such a cell at the ground instead gives
+/// it the light of a shorter path than its neighbours', and a surface seen between the two
+/// rows read 10 % too little in-scattering (−5° at 17 km from a 1.5 km eye); lifted, 3 %.
+/// Cells past the top of the air stop there.
+pub fn aerial_target(p: &AtmosphereGpu, dir: Vec3, s: f32) -> (Vec3, f32) {
+    let o = p.eye();
+    let t_ground = ray_sphere_nearest(o, dir, p.ground());
+    if t_ground < 0.0 || s <= t_ground {
+        return (dir, s.min(exit_distance(p, dir)));
+    }
+    let x = o + dir * s;
+    let v = x * ((p.ground() + 1e-3) / x.length()) - o;
+    let len = v.length();
+    (v / len.max(1e-12), len)
 }
 
 impl Luts {

@@ -29,8 +29,11 @@ pub const SKY_VIEW_SIZE: [usize; 2] = [192, 108];
 /// Texels of the aerial-perspective volume (azimuth, zenith, distance); two texels each
 /// (in-scattering, then transmittance).
 pub const AERIAL_SIZE: [usize; 3] = [32, 32, 32];
-/// Directions per axis of the multiple-scattering table's sphere (the square of it in all).
-pub const MULTI_DIRECTIONS: usize = 8;
+/// The multiple-scattering table's sphere of directions: azimuths × zenith-cosine bands (64
+/// in all, as in the paper; the bands are split at the horizon and crowd toward it, see
+/// `lut::band`).
+pub const MULTI_AZIMUTHS: usize = 4;
+pub const MULTI_BANDS: usize = 16;
 /// Quadrature steps: transmittance, multiple scattering (per direction), sky view, aerial.
 pub const STEPS: [u32; 4] = [40, 20, 30, 20];
 
@@ -182,6 +185,12 @@ pub fn transmittance_r_mu(p: &AtmosphereGpu, x_mu: f32, x_r: f32) -> (f32, f32) 
         (h * h - rho * rho - d * d) / (2.0 * r * d)
     };
     (r, mu.clamp(-1.0, 1.0))
+}
+
+/// Cosine of the horizon's zenith angle seen from radius `r` (0 on the ground, negative above).
+pub fn horizon_cosine(p: &AtmosphereGpu, r: f32) -> f32 {
+    let q = p.ground() / r.max(p.ground());
+    -(1.0 - q * q).max(0.0).sqrt()
 }
 
 /// The horizon's zenith angle θ_h seen from radius `r` and β = π − θ_h.
