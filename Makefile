@@ -121,6 +121,9 @@ docs-images: build
 	$(PLAYER) scenes/freeform/column.ron --headless -q --size 320x240 \
 	    --out $(DOCS_OUT)/freeform-column-frames
 	cp $(DOCS_OUT)/freeform-column-frames/frame_0000.png docs/images/freeform-column.png
+	$(PLAYER) scenes/freeform/valley-air.ron --headless -q --size 320x180 \
+	    --out $(DOCS_OUT)/freeform-valley-air-frames
+	cp $(DOCS_OUT)/freeform-valley-air-frames/frame_0000.png docs/images/freeform-valley-air.png
 	$(BAKE) -q study radiosity --out $(DOCS_OUT)/study/radiosity
 	$(BAKE) -q study compression --out $(DOCS_OUT)/study/compression
 	$(BAKE) -q study terrain --sizes 512,1024,2048 --elevations 5,30 --soft-elevations 2,5 \

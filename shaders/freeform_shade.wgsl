@@ -1,8 +1,11 @@
 // Shading of a freeform frame (after `freeform.wgsl` cast it): Lambert and Phong under the sun,
 // an ambient fraction, sun shadows from the shadow pass, the background where the ray missed,
 // exposure, sRGB; thematic textures over every surface when the scene has them (theme.wgsl,
-// group 2). Rust twins: relume::render::freeform_shade::{shade32, themed_albedo}.
+// group 2); the air when the scene has one (aerial perspective and sky by the frame's model,
+// Hillaire's tables in group 3). Rust twins: relume::render::freeform_shade::{shade32,
+// themed_albedo, through_air}.
 //! include theme.wgsl
+//! include atmosphere_lookup.wgsl
 
 struct ShadeFrame {
     forward: vec4<f32>,    // xyz, tan_x
@@ -13,6 +16,13 @@ struct ShadeFrame {
     size: vec4<u32>,       // width, height, shadows, theme projection (0 none, 1 planar, 2 spherical)
     eye: vec4<f32>,        // xyz eye (world), w: the angle one pixel spans
     projection: vec4<f32>, // planar: min x, min z, max x, max z; spherical: centre xyz
+    air: vec4<u32>,        // model (0 none, 1/2 seed fog per pixel, 3 Hillaire), unused x3
+    air_scale: vec4<f32>,  // km per scene unit, unused x3
+    sun_light: vec4<f32>,  // the sun's colour on surfaces (rgb), unused
+    fog_ext: vec4<f32>,    // seed model: extinction per km (rgb), w: Mie g
+    fog_rayleigh: vec4<f32>,
+    fog_mie: vec4<f32>,
+    fog_sun: vec4<f32>,    // sun illuminance lighting the air (rgb), w: radiance scale (pi)
 }
 
 @group(0) @binding(0) var<uniform> shade_frame: ShadeFrame;
@@ -58,6 +68,34 @@ fn freeform_theme_albedo(d: vec3<f32>, t: f32) -> vec3<f32> {
     return theme_albedo(vec2<f32>(u * iw, v * ih), footprint);
 }
 
+// Radiance rgb of a surface at distance t (scene units) along unit d, or of the background
+// where the ray missed (hit false), seen through the air: twin of
+// relume::render::freeform_shade::through_air.
+fn through_air(rgb: vec3<f32>, d: vec3<f32>, t: f32, hit: bool) -> vec3<f32> {
+    let model = shade_frame.air.x;
+    let scale = shade_frame.fog_sun.w;
+    if (model == 1u || model == 2u) {
+        var s_km = 1e9;
+        var l0 = vec3<f32>(0.0);
+        if (hit) {
+            s_km = t * shade_frame.air_scale.x;
+            l0 = rgb;
+        }
+        let inscatter = fog(vec3<f32>(0.0), s_km, dot(d, shade_frame.sun.xyz), shade_frame.fog_ext.xyz,
+            shade_frame.fog_rayleigh.xyz, shade_frame.fog_mie.xyz, shade_frame.fog_ext.w,
+            shade_frame.fog_sun.xyz) * scale;
+        return l0 * exp(-shade_frame.fog_ext.xyz * s_km) + inscatter;
+    }
+    if (model == 3u) {
+        if (hit) {
+            let m = aerial_perspective(d, t * shade_frame.air_scale.x);
+            return rgb * m.transmittance + m.inscatter * scale;
+        }
+        return sky_radiance(d) * scale;
+    }
+    return rgb;
+}
+
 @compute @workgroup_size(8, 8)
 fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = shade_frame.size.x;
@@ -66,10 +104,10 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.y * w + id.x;
     let hit = hit_normals[i];
     var rgb = shade_frame.background.xyz;
+    let x = (( f32(id.x) + 0.5) / f32(w) * 2.0 - 1.0) * shade_frame.forward.w;
+    let y = (1.0 - (f32(id.y) + 0.5) / f32(h) * 2.0) * shade_frame.right.w;
+    let d = normalize(shade_frame.forward.xyz + x * shade_frame.right.xyz + y * shade_frame.up.xyz);
     if (hit.x >= 0.0) {
-        let x = (( f32(id.x) + 0.5) / f32(w) * 2.0 - 1.0) * shade_frame.forward.w;
-        let y = (1.0 - (f32(id.y) + 0.5) / f32(h) * 2.0) * shade_frame.right.w;
-        let d = normalize(shade_frame.forward.xyz + x * shade_frame.right.xyz + y * shade_frame.up.xyz);
         let n = hit.yzw;
         let l = shade_frame.sun.xyz;
         let s = shadow_state[i];
@@ -84,8 +122,10 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         if (shade_frame.size.w != 0u) {
             albedo = freeform_theme_albedo(d, hit.x);
         }
-        rgb = albedo * (a + (1.0 - a) * ndl * vis) + vec3<f32>(spec);
+        let sun_c = shade_frame.sun_light.xyz;
+        rgb = albedo * (a + (1.0 - a) * ndl * vis * sun_c) + spec * sun_c;
     }
+    rgb = through_air(rgb, d, hit.x, hit.x >= 0.0);
     let e = rgb * shade_frame.up.w;
     let c = vec3<f32>(linear_to_srgb(clamp(e.x, 0.0, 1.0)), linear_to_srgb(clamp(e.y, 0.0, 1.0)), linear_to_srgb(clamp(e.z, 0.0, 1.0)));
     textureStore(shaded, vec2<i32>(id.xy), vec4<f32>(c, 1.0));

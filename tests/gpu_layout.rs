@@ -132,6 +132,13 @@ fn shared_structs() -> Vec<Shared> {
             "size": field!(ShadeFrameU, size),
             "eye": field!(ShadeFrameU, eye),
             "projection": field!(ShadeFrameU, projection),
+            "air": field!(ShadeFrameU, air),
+            "air_scale": field!(ShadeFrameU, air_scale),
+            "sun_light": field!(ShadeFrameU, sun_light),
+            "fog_ext": field!(ShadeFrameU, fog_ext),
+            "fog_rayleigh": field!(ShadeFrameU, fog_rayleigh),
+            "fog_mie": field!(ShadeFrameU, fog_mie),
+            "fog_sun": field!(ShadeFrameU, fog_sun),
         }),
         shared!("freeform.wgsl", "Leaf", GpuLeaf {
             "base": field!(GpuLeaf, base),

@@ -67,7 +67,14 @@ fn compare(gpu: &Gpu, model: Model, sun: Sun) -> (usize, usize, u8) {
     // The CPU frame.
     let atm = Atmosphere::earth();
     let eye = camera.eye.as_dvec3();
-    let air = air_frame(&atm, model, &sun, eye.y, 0.0, s.sun_strength);
+    let air = air_frame(
+        &atm,
+        model,
+        sun.toward_y_up_f64(),
+        eye.y,
+        0.0,
+        s.sun_strength,
+    );
     let sw = sun.toward_y_up_f64();
     let fog = FogParams::new(&atm, eye.y, sw, false);
     let luts = (model == Model::Hillaire).then(|| {

@@ -9,13 +9,15 @@
 //! [`Atmosphere::ground_radius`] (default 6,371 km, the radius curved terrain uses; Hillaire
 //! uses 6,360 km) with the air up to [`Atmosphere::top_radius`] (ground + 100 km).
 //!
-//! Files: `fog.rs` (seed model, per pixel and per vertex), `reference.rs` (quadrature),
+//! Files: `fog.rs` (seed model, per pixel and per vertex), `frame.rs` (the air's uniform fields
+//! of a rendered frame), `reference.rs` (quadrature),
 //! `monte_carlo.rs` (path tracer), `twin.rs` (the f32 parameters shared with
 //! `shaders/atmosphere.wgsl`, parameterisations, filtering), `lut.rs` (building the tables and
 //! the lookups a renderer calls), `study.rs` (error against sun elevation).
 
 pub mod double;
 pub mod fog;
+pub mod frame;
 pub mod lut;
 pub mod monte_carlo;
 pub mod reference;

@@ -83,10 +83,12 @@ struct Cli {
     /// horizon maps (which give them in O(1) per pixel, interpolated between stored azimuths)
     #[arg(long)]
     no_horizon: bool,
-    /// Terrain: no aerial perspective and no sky (same as --atmosphere none)
+    /// Terrain and freeform scenes with `air`: no aerial perspective and no sky (same as
+    /// --atmosphere none)
     #[arg(long)]
     no_fog: bool,
-    /// Terrain: the atmosphere model of the aerial perspective and the sky (docs/atmosphere.md)
+    /// Terrain and freeform scenes with `air`: the atmosphere model of the aerial perspective
+    /// and the sky (docs/atmosphere.md)
     #[arg(long, value_enum, value_name = "MODEL", default_value_t = relume::atmosphere::Model::Hillaire)]
     atmosphere: relume::atmosphere::Model,
     /// Terrain: the hypsometric tint instead of the bake's thematic textures

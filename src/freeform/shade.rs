@@ -17,10 +17,12 @@ pub enum Method {
     Rmlrc(RmlrcParams),
 }
 
-/// Lighting of a frame: unit vector toward the sun (y up), ambient fraction, background.
+/// Lighting of a frame: unit vector toward the sun (y up), the sun's colour on surfaces (white,
+/// or reddened by the air), ambient fraction, background.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lighting {
     pub sun: [f64; 3],
+    pub sun_colour: [f64; 3],
     pub ambient: f64,
     pub background: [f64; 3],
     pub shadows: bool,
@@ -116,8 +118,10 @@ pub fn render_with(
             let spec = leaf.specular * vis * (-dot(refl, dir)).max(0.0).powi(32);
             let a = light.ambient;
             let color = albedo.map_or(leaf.color, |f| f(dir, t));
-            let rgb =
-                std::array::from_fn(|k| (color[k] * (a + (1.0 - a) * ndl * vis) + spec) as f32);
+            let c = light.sun_colour;
+            let rgb = std::array::from_fn(|k| {
+                (color[k] * (a + (1.0 - a) * ndl * vis * c[k]) + spec * c[k]) as f32
+            });
             (rgb, n.map(|v| v as f32))
         })
         .collect();

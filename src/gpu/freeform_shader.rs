@@ -1,11 +1,15 @@
 //! Shading of a freeform cast on wgpu (`shaders/freeform_shade.wgsl`; CPU twin
 //! `render::freeform_shade::shade32`): from the cast's hits and shadow state into an RGBA8
-//! storage target.
+//! storage target; the air (aerial perspective and sky) when the scene has one, Hillaire's
+//! tables bound as group 3.
 
+use super::atmosphere::AtmosphereTables;
 use super::compute;
 use super::freeform_caster::GpuCast;
 use super::themes::ThemeGpu;
 use super::Gpu;
+use crate::atmosphere::frame::AirFrame;
+use crate::atmosphere::twin::AtmosphereGpu;
 use crate::error::Result;
 use crate::freeform::twin::View32;
 use crate::render::freeform_shade::Shading;
@@ -22,6 +26,13 @@ pub struct ShadeFrameU {
     pub size: [u32; 4],
     pub eye: [f32; 4],
     pub projection: [f32; 4],
+    pub air: [u32; 4],
+    pub air_scale: [f32; 4],
+    pub sun_light: [f32; 4],
+    pub fog_ext: [f32; 4],
+    pub fog_rayleigh: [f32; 4],
+    pub fog_mie: [f32; 4],
+    pub fog_sun: [f32; 4],
 }
 
 pub struct FreeformShader {
@@ -32,6 +43,27 @@ pub struct FreeformShader {
     theme_group: wgpu::BindGroup,
     empty_group: wgpu::BindGroup,
     projection: (u32, [f32; 4]),
+    /// Hillaire's tables (built on the first Hillaire frame) and group 3 (placeholders
+    /// until then).
+    tables: Option<AtmosphereTables>,
+    air_group: wgpu::BindGroup,
+}
+
+/// Group 3 of `pipeline` over (parameters, sky view, aerial volume).
+fn air_bind(gpu: &Gpu, pipeline: &wgpu::ComputePipeline, b: [&wgpu::Buffer; 3]) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = b
+        .iter()
+        .enumerate()
+        .map(|(i, buf)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: buf.as_entire_binding(),
+        })
+        .collect();
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("freeform air"),
+        layout: &pipeline.get_bind_group_layout(3),
+        entries: &entries,
+    })
 }
 
 impl FreeformShader {
@@ -44,13 +76,39 @@ impl FreeformShader {
             layout: &pipeline.get_bind_group_layout(1),
             entries: &[],
         });
+        let placeholder = [
+            compute::uniform(gpu, "atmosphere placeholder", &AtmosphereGpu::default()),
+            compute::storage(gpu, "sky placeholder", &[0u32; 4]),
+            compute::storage(gpu, "aerial placeholder", &[0u32; 4]),
+        ];
+        let air_group = air_bind(
+            gpu,
+            &pipeline,
+            [&placeholder[0], &placeholder[1], &placeholder[2]],
+        );
         Ok(FreeformShader {
             pipeline,
             themes,
             theme_group,
             empty_group,
             projection: (0, [0.0; 4]),
+            tables: None,
+            air_group,
         })
+    }
+
+    /// Make Hillaire's tables hold `p` (eye altitude, sun, range): built on first use, else
+    /// updated in place.
+    pub fn prepare_air_tables(&mut self, gpu: &Gpu, p: &AtmosphereGpu) -> Result<()> {
+        match &mut self.tables {
+            Some(t) => t.update(gpu, p)?,
+            None => {
+                let t = AtmosphereTables::build(gpu, p)?;
+                self.air_group = air_bind(gpu, &self.pipeline, [&t.params, &t.sky_view, &t.aerial]);
+                self.tables = Some(t);
+            }
+        }
+        Ok(())
     }
 
     /// Texture every surface with `set`, laid on the scene by `projection` (kind 1 planar /
@@ -76,7 +134,9 @@ impl FreeformShader {
     }
 
     /// Shade `cast` (of `view`, its eye at `eye`) into `target` (a storage-capable RGBA8 view
-    /// of the view's size); `themed` applies the themes set with [`Self::set_themes`].
+    /// of the view's size); `themed` applies the themes set with [`Self::set_themes`]; `air`
+    /// the frame's air and the scene's km per unit (Hillaire's model needs
+    /// [`Self::prepare_air_tables`] first).
     #[allow(clippy::too_many_arguments)]
     pub fn shade(
         &self,
@@ -86,9 +146,20 @@ impl FreeformShader {
         eye: [f32; 3],
         s: &Shading,
         themed: bool,
+        air: Option<(&AirFrame, f32)>,
         target: &wgpu::TextureView,
     ) {
         let kind = if themed { self.projection.0 } else { 0 };
+        let none = AirFrame {
+            sun_light: [1.0, 1.0, 1.0, 0.0],
+            ..AirFrame::default()
+        };
+        let (a, km) = air.unwrap_or((&none, 0.0));
+        let model = if a.model == 3 && self.tables.is_none() {
+            0
+        } else {
+            a.model
+        };
         let u = ShadeFrameU {
             forward: [
                 view.forward[0],
@@ -103,6 +174,13 @@ impl FreeformShader {
             size: [view.width, view.height, u32::from(s.shadows), kind],
             eye: [eye[0], eye[1], eye[2], 2.0 * view.tan_x / view.width as f32],
             projection: self.projection.1,
+            air: [model, 0, 0, 0],
+            air_scale: [km, 0.0, 0.0, 0.0],
+            sun_light: a.sun_light,
+            fog_ext: a.fog_ext,
+            fog_rayleigh: a.fog_rayleigh,
+            fog_mie: a.fog_mie,
+            fog_sun: a.fog_sun,
         };
         let ub = compute::uniform(gpu, "freeform shade", &u);
         let group = compute::bind(
@@ -123,6 +201,7 @@ impl FreeformShader {
             pass.set_bind_group(0, &group, &[]);
             pass.set_bind_group(1, &self.empty_group, &[]);
             pass.set_bind_group(2, &self.theme_group, &[]);
+            pass.set_bind_group(3, &self.air_group, &[]);
             pass.dispatch_workgroups(view.width.div_ceil(8), view.height.div_ceil(8), 1);
         }
         gpu.queue.submit([enc.finish()]);

@@ -3,86 +3,17 @@
 //! moves), and the sky pass (`vs_sky`/`fs_sky` of `terrain_render.wgsl`, drawn after the
 //! terrain where the depth buffer is still at the far plane).
 //!
-//! Units: the terrain's radiance is albedo × (E·cos + sky), without the 1/π of a Lambertian
-//! surface, so the air's radiance is multiplied by π (`fog_sun.w`) to match. The sun lighting
-//! the terrain is the top-of-air sun for the seed's model (its assumption) and the sun seen
-//! through the air from the terrain's mean altitude for Hillaire's (f64 quadrature,
-//! `atmosphere::reference::sun_transmittance`): low suns redden and dim.
+//! The uniform fields themselves (units, the sun on surfaces) are `atmosphere::frame`'s,
+//! shared with the freeform renderer.
 
 use super::atmosphere::AtmosphereTables;
 use super::render_target::{DEPTH_FORMAT, TARGET_FORMAT};
 use super::{compute, Gpu};
-use crate::atmosphere::fog::FogParams;
+pub use crate::atmosphere::frame::{air_frame, AirFrame, SKY};
 use crate::atmosphere::twin::AtmosphereGpu;
-use crate::atmosphere::{eye_position, reference, Atmosphere, Model};
+use crate::atmosphere::Atmosphere;
 use crate::error::Result;
 use crate::terrain::sun::Sun;
-
-/// The air's fields of the `TerrainFrame` uniform.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct AirFrame {
-    pub sun_light: [f32; 4],
-    pub fog_ext: [f32; 4],
-    pub fog_rayleigh: [f32; 4],
-    pub fog_mie: [f32; 4],
-    pub fog_sun: [f32; 4],
-    /// 0 none, 1 seed fog per vertex, 2 per pixel, 3 Hillaire.
-    pub model: u32,
-}
-
-/// The sky (ambient) term of the terrain's lighting.
-pub const SKY: f32 = 0.15;
-
-/// The air's uniform fields for `model` with the eye at `eye_altitude` m, the terrain's mean
-/// altitude `ground_altitude` m, sun strength `strength`.
-pub fn air_frame(
-    atm: &Atmosphere,
-    model: Model,
-    sun: &Sun,
-    eye_altitude: f64,
-    ground_altitude: f64,
-    strength: f32,
-) -> AirFrame {
-    let s = sun.toward_y_up_f64();
-    let f = FogParams::new(atm, eye_altitude, s, false);
-    let km = |v: [f64; 3], w: f64| {
-        [
-            v[0] as f32 * 1e3,
-            v[1] as f32 * 1e3,
-            v[2] as f32 * 1e3,
-            w as f32,
-        ]
-    };
-    let light = match model {
-        Model::Hillaire => reference::sun_transmittance(atm, eye_position(atm, ground_altitude), s),
-        _ => [1.0; 3],
-    };
-    let sun_light = std::array::from_fn(|c| {
-        if c == 3 {
-            SKY
-        } else {
-            (light[c] * atm.sun_illuminance[c]) as f32 * strength
-        }
-    });
-    AirFrame {
-        sun_light,
-        fog_ext: km(f.extinction, f.mie_g),
-        fog_rayleigh: km(f.rayleigh, 0.0),
-        fog_mie: km(f.mie, 0.0),
-        fog_sun: [
-            f.sun[0] as f32 * strength,
-            f.sun[1] as f32 * strength,
-            f.sun[2] as f32 * strength,
-            std::f32::consts::PI,
-        ],
-        model: match model {
-            Model::None => 0,
-            Model::Fog => 1,
-            Model::FogPerPixel => 2,
-            Model::Hillaire => 3,
-        },
-    }
-}
 
 /// The group-3 bindings of the terrain's explicit layout (all three) and of the sky
 /// pipeline's automatic one (only what it reads: the parameters and the sky view).

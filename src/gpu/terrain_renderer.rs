@@ -413,7 +413,7 @@ impl TerrainRenderer {
         let air = air_frame(
             &self.air.atmosphere,
             s.atmosphere,
-            &self.sun,
+            self.sun.toward_y_up_f64(),
             eye_altitude,
             ground.max(0.0),
             s.sun_strength,

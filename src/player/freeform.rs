@@ -1,9 +1,13 @@
 //! Freeform scenes at runtime (`relume-player scenes/freeform/X.ron`): the scene's field cast on
 //! the GPU each frame by the multilevel caster (`gpu::freeform_caster`), sun shadows by the
 //! same search toward the sun, and the shading kernel (`gpu::freeform_shader`) into the target.
-//! Thematic textures over every surface when the scene names a theme set (docs/themes.md).
+//! Thematic textures over every surface when the scene names a theme set (docs/themes.md); the
+//! air (aerial perspective and sky by the frame's atmosphere model) when it has `air`.
 //! The sun and the camera move freely; nothing is baked.
 
+use crate::atmosphere::frame::{air_frame, AirFrame};
+use crate::atmosphere::twin::AtmosphereGpu;
+use crate::atmosphere::{Atmosphere, Model};
 use crate::error::{Error, Result};
 use crate::freeform::rmlrc::{camera_outside, RmlrcParams};
 use crate::freeform::shade::sun_direction;
@@ -15,9 +19,9 @@ use crate::gpu::render_target::RenderTarget;
 use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
 use crate::render::camera::Camera;
-use crate::render::freeform_shade::Shading;
+use crate::render::freeform_shade::{air_placement, Shading};
 use crate::render::mesh_reference::FrameSettings;
-use crate::scene::freeform::{FreeformCamera, FreeformScene};
+use crate::scene::freeform::{FreeformCamera, FreeformScene, SceneAir};
 use crate::terrain::sun::Sun;
 use glam::Vec3;
 use std::path::Path;
@@ -158,6 +162,10 @@ impl FreeformPlayer {
             shadows: s.shadows,
         };
         let eye = view.eye.map(|v| v as f32);
+        let air = match self.scene.air {
+            Some(a) => Some(self.air(gpu, &a, &view, l, s)?),
+            None => None,
+        };
         self.shader.shade(
             gpu,
             &run,
@@ -165,9 +173,31 @@ impl FreeformPlayer {
             eye,
             &shading,
             s.themes && self.themes.is_some(),
+            air.as_ref().map(|(f, km)| (f, *km)),
             &self.target.view,
         );
         Ok(())
+    }
+
+    /// The air of this frame over a scene placed by `a` (the model: `s.atmosphere`, none when
+    /// `s.fog` is off), with Hillaire's tables prepared for the eye's altitude and the sun.
+    fn air(
+        &mut self,
+        gpu: &Gpu,
+        a: &SceneAir,
+        view: &View,
+        sun: [f32; 3],
+        s: &FrameSettings,
+    ) -> Result<(AirFrame, f32)> {
+        let atm = Atmosphere::earth();
+        let model = if s.fog { s.atmosphere } else { Model::None };
+        let (eye_altitude, sun, range) = air_placement(a, view.eye[1], view.far, sun, &atm);
+        let frame = air_frame(&atm, model, sun, eye_altitude, 0.0, 1.0);
+        if model == Model::Hillaire {
+            let p = AtmosphereGpu::new(&atm, eye_altitude, sun, range);
+            self.shader.prepare_air_tables(gpu, &p)?;
+        }
+        Ok((frame, (a.metres_per_unit / 1000.0) as f32))
     }
 
     /// Resize the target.

@@ -23,9 +23,9 @@ pub struct FrameSettings {
     /// Terrain: hard shadows from the bake's horizon maps when it has them (else the
     /// traversal over the min/max mipmap).
     pub horizon_shadows: bool,
-    /// Terrain: aerial perspective and sky (by `atmosphere`).
+    /// Terrain and freeform scenes with `air`: aerial perspective and sky (by `atmosphere`).
     pub fog: bool,
-    /// Terrain: which atmosphere model draws them.
+    /// Terrain and freeform scenes with `air`: which atmosphere model draws them.
     pub atmosphere: crate::atmosphere::Model,
     /// Terrain: thematic textures when the bake has a theme set (else the hypsometric tint).
     pub themes: bool,

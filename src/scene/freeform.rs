@@ -45,6 +45,45 @@ pub struct FreeformScene {
     /// (docs/themes.md) and how its index map is laid on the scene.
     #[serde(default)]
     pub themes: Option<SceneThemes>,
+    /// The air over the scene (aerial perspective and sky, docs/atmosphere.md): how large the
+    /// scene is in the world. Without it, nothing is drawn through the air.
+    #[serde(default)]
+    pub air: Option<SceneAir>,
+}
+
+/// How a freeform scene sits in the planet's air: the scene's +y is up, its unit is
+/// `metres_per_unit` metres and the plane y = `sea_level` is altitude 0 (the surfaces are the
+/// scene's own; the air's ground sphere only shapes the sky and the tables).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneAir {
+    pub metres_per_unit: f64,
+    #[serde(default)]
+    pub sea_level: f64,
+}
+
+impl SceneAir {
+    /// Check the numbers.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        if !(self.metres_per_unit.is_finite() && self.metres_per_unit > 0.0) {
+            return Err(format!(
+                "air: metres_per_unit must be a positive number, got {}",
+                self.metres_per_unit
+            ));
+        }
+        if !self.sea_level.is_finite() {
+            return Err(format!(
+                "air: sea_level must be finite, got {}",
+                self.sea_level
+            ));
+        }
+        Ok(())
+    }
+
+    /// Altitude (m) of a scene point's y.
+    pub fn altitude(&self, y: f64) -> f64 {
+        (y - self.sea_level) * self.metres_per_unit
+    }
 }
 
 /// A theme set laid over a freeform scene.
@@ -287,6 +326,9 @@ impl FreeformScene {
     fn check(&self) -> std::result::Result<(), String> {
         if let Some(t) = &self.themes {
             t.projection.check()?;
+        }
+        if let Some(a) = &self.air {
+            a.check()?;
         }
         let mut leaves = Vec::new();
         self.shape.surfaces(&mut leaves);

@@ -2,10 +2,16 @@
 //! by recursive multilevel ray casting. Thin: parse, check, call the library, write atomically.
 
 use clap::{Args, Subcommand, ValueEnum};
+use rayon::prelude::*;
+use relume::atmosphere::frame::air_frame;
+use relume::atmosphere::lut::Luts;
+use relume::atmosphere::twin::AtmosphereGpu;
 use relume::baked::images::{self, check_extension};
 use relume::error::exit;
 use relume::freeform::{self, Bound, Field, Lighting, Method, RmlrcParams, View};
-use relume::render::freeform_shade::{themed_albedo, ThemeView};
+use relume::render::freeform_shade::{
+    air_placement, themed_albedo, through_air, FreeformAir, ThemeView,
+};
 use relume::render::tonemap::linear_to_srgb8;
 use relume::scene::freeform::FreeformCamera;
 use relume::{Error, Result};
@@ -95,6 +101,10 @@ pub struct RenderArgs {
     /// Morph parameter of the shape textures, in [0, 1]: heights (1 − S)·heights + S·morph_to
     #[arg(long, value_name = "S", default_value_t = 0.0)]
     pub morph: f64,
+    /// For a scene with `air`: the atmosphere model of the aerial perspective and the sky, as
+    /// the player draws them (docs/atmosphere.md); `none` leaves surfaces and background as is
+    #[arg(long, value_enum, value_name = "MODEL", default_value_t = relume::atmosphere::Model::Hillaire)]
+    pub atmosphere: relume::atmosphere::Model,
 }
 
 fn triple(s: &str) -> Result<[f64; 3], String> {
@@ -192,8 +202,22 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
         MethodArg::Reference => Method::Reference,
         MethodArg::Rmlrc => Method::Rmlrc(params),
     };
+    let sun = freeform::shade::sun_direction(az, el);
+    // The scene's air, by the player's twin (render::freeform_shade::through_air).
+    let atm = relume::atmosphere::Atmosphere::earth();
+    let air = scene.air.map(|sa| {
+        let (alt, sun_f64, range) =
+            air_placement(&sa, view.eye[1], view.far, sun.map(|v| v as f32), &atm);
+        let frame = air_frame(&atm, a.atmosphere, sun_f64, alt, 0.0, 1.0);
+        let luts = (a.atmosphere == relume::atmosphere::Model::Hillaire)
+            .then(|| Luts::build(&AtmosphereGpu::new(&atm, alt, sun_f64, range)));
+        (frame, (sa.metres_per_unit / 1000.0) as f32, luts)
+    });
     let light = Lighting {
-        sun: freeform::shade::sun_direction(az, el),
+        sun,
+        sun_colour: air.as_ref().map_or([1.0; 3], |(f, _, _)| {
+            std::array::from_fn(|k| f.sun_light[k] as f64)
+        }),
         ambient: scene.ambient,
         background: scene.background,
         shadows: !a.no_shadows,
@@ -232,9 +256,24 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
         &light,
         theme_view.is_some().then_some(&albedo as _),
     );
+    let mut rgb = frame.rgb.clone();
+    if let Some((f, km, luts)) = &air {
+        let fa = FreeformAir {
+            frame: *f,
+            km_per_unit: *km,
+            luts: luts.as_ref(),
+        };
+        let s32 = sun.map(|v| v as f32);
+        rgb.par_iter_mut().enumerate().for_each(|(i, c)| {
+            let (d, _) = view.pixel_ray(i as u32 % w, i as u32 / w);
+            let t = frame.depth[i];
+            let t = t.is_finite().then_some(t as f32);
+            *c = through_air(*c, d.map(|v| v as f32), t, s32, &fa);
+        });
+    }
     let seconds = t0.elapsed().as_secs_f64();
     let mut img = image::RgbaImage::new(w, h);
-    for (px, rgb) in img.pixels_mut().zip(&frame.rgb) {
+    for (px, rgb) in img.pixels_mut().zip(&rgb) {
         let [r, g, b] = rgb.map(linear_to_srgb8);
         *px = image::Rgba([r, g, b, 255]);
     }

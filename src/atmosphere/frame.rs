@@ -1,0 +1,94 @@
+//! The air's part of a frame: the uniform fields every renderer of relume hands its shaders
+//! (terrain: `shaders/terrain_render.wgsl`; freeform surfaces: `shaders/freeform_shade.wgsl`)
+//! for one model, sun and eye altitude.
+//!
+//! Units: surfaces are shaded as albedo × (E·cos + sky), without the 1/π of a Lambertian
+//! surface, so the air's radiance is multiplied by π (`fog_sun.w`) to match. The sun lighting
+//! surfaces is the top-of-air sun for the seed's model (its assumption) and, for Hillaire's,
+//! the sun seen through the air from the ground's altitude (f64 quadrature,
+//! `reference::sun_transmittance`): low suns redden and dim.
+
+use super::fog::FogParams;
+use super::{eye_position, reference, Atmosphere, Model};
+use glam::DVec3;
+
+/// The air's uniform fields of a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AirFrame {
+    /// RGB: the sun's illuminance on surfaces (× strength); w: the sky (ambient) term.
+    pub sun_light: [f32; 4],
+    /// The seed model: extinction per km (RGB), w: Mie g.
+    pub fog_ext: [f32; 4],
+    /// Rayleigh scattering per km (RGB).
+    pub fog_rayleigh: [f32; 4],
+    /// Mie scattering per km (RGB).
+    pub fog_mie: [f32; 4],
+    /// Sun illuminance lighting the air (RGB), w: the radiance scale (π).
+    pub fog_sun: [f32; 4],
+    /// 0 none, 1 seed fog per vertex, 2 per pixel, 3 Hillaire.
+    pub model: u32,
+}
+
+/// The sky (ambient) term of the terrain's lighting.
+pub const SKY: f32 = 0.15;
+
+/// The air's uniform fields for `model` with the sun toward unit `sun` (eye frame, +Y up), the
+/// eye at `eye_altitude` m, the ground (what the sun lights) at `ground_altitude` m, sun
+/// strength `strength`.
+pub fn air_frame(
+    atm: &Atmosphere,
+    model: Model,
+    sun: DVec3,
+    eye_altitude: f64,
+    ground_altitude: f64,
+    strength: f32,
+) -> AirFrame {
+    let f = FogParams::new(atm, eye_altitude, sun, false);
+    let km = |v: [f64; 3], w: f64| {
+        [
+            v[0] as f32 * 1e3,
+            v[1] as f32 * 1e3,
+            v[2] as f32 * 1e3,
+            w as f32,
+        ]
+    };
+    let light = match model {
+        Model::Hillaire => {
+            reference::sun_transmittance(atm, eye_position(atm, ground_altitude), sun)
+        }
+        _ => [1.0; 3],
+    };
+    let sun_light = std::array::from_fn(|c| {
+        if c == 3 {
+            SKY
+        } else {
+            (light[c] * atm.sun_illuminance[c]) as f32 * strength
+        }
+    });
+    AirFrame {
+        sun_light,
+        fog_ext: km(f.extinction, f.mie_g),
+        fog_rayleigh: km(f.rayleigh, 0.0),
+        fog_mie: km(f.mie, 0.0),
+        fog_sun: [
+            f.sun[0] as f32 * strength,
+            f.sun[1] as f32 * strength,
+            f.sun[2] as f32 * strength,
+            std::f32::consts::PI,
+        ],
+        model: model.code(),
+    }
+}
+
+impl Model {
+    /// The shaders' number for the model: 0 none, 1 seed fog per vertex, 2 per pixel, 3
+    /// Hillaire.
+    pub fn code(self) -> u32 {
+        match self {
+            Model::None => 0,
+            Model::Fog => 1,
+            Model::FogPerPixel => 2,
+            Model::Hillaire => 3,
+        }
+    }
+}
