@@ -105,6 +105,7 @@ fn gpu_shadows_and_shading_return_the_twins() {
             themes.is_some(),
             air.as_ref().map(|(f, km, _)| (f, *km)),
             &target.view,
+            None,
         );
         let theme_view = themes.as_ref().map(|(set, (kind, projection))| ThemeView {
             look: set.lookup(4),

@@ -7,6 +7,7 @@ use super::atmosphere::AtmosphereTables;
 use super::compute;
 use super::freeform_caster::GpuCast;
 use super::themes::ThemeGpu;
+use super::timing::PassTimer;
 use super::Gpu;
 use crate::atmosphere::frame::AirFrame;
 use crate::atmosphere::twin::AtmosphereGpu;
@@ -136,7 +137,7 @@ impl FreeformShader {
     /// Shade `cast` (of `view`, its eye at `eye`) into `target` (a storage-capable RGBA8 view
     /// of the view's size); `themed` applies the themes set with [`Self::set_themes`]; `air`
     /// the frame's air and the scene's km per unit (Hillaire's model needs
-    /// [`Self::prepare_air_tables`] first).
+    /// [`Self::prepare_air_tables`] first); `timer` times the pass as "shade".
     #[allow(clippy::too_many_arguments)]
     pub fn shade(
         &self,
@@ -148,6 +149,7 @@ impl FreeformShader {
         themed: bool,
         air: Option<(&AirFrame, f32)>,
         target: &wgpu::TextureView,
+        timer: Option<&mut PassTimer>,
     ) {
         let kind = if themed { self.projection.0 } else { 0 };
         let none = AirFrame {
@@ -195,14 +197,21 @@ impl FreeformShader {
             ],
         );
         let mut enc = gpu.device.create_command_encoder(&Default::default());
+        let mut timer = timer;
         {
-            let mut pass = enc.begin_compute_pass(&Default::default());
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("freeform shade"),
+                timestamp_writes: timer.as_mut().and_then(|t| t.compute("shade")),
+            });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &group, &[]);
             pass.set_bind_group(1, &self.empty_group, &[]);
             pass.set_bind_group(2, &self.theme_group, &[]);
             pass.set_bind_group(3, &self.air_group, &[]);
             pass.dispatch_workgroups(view.width.div_ceil(8), view.height.div_ceil(8), 1);
+        }
+        if let Some(t) = &timer {
+            t.resolve(&mut enc);
         }
         gpu.queue.submit([enc.finish()]);
         gpu.wait();

@@ -175,6 +175,7 @@ impl FreeformPlayer {
             s.themes && self.themes.is_some(),
             air.as_ref().map(|(f, km)| (f, *km)),
             &self.target.view,
+            Some(timer),
         );
         Ok(())
     }
