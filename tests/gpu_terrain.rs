@@ -190,8 +190,13 @@ fn themed_map_view_matches_the_cpu_shading() {
     // render::terrain_shading::map_view with theme::compose.
     let Some(gpu) = gpu() else { return };
     let map = puget_512();
+    let given = relume::load::themes::GivenHeightMap {
+        map: &map,
+        georef: None,
+        name: "the Puget Sound height map",
+    };
     let set =
-        relume::load::themes::load_themes(&common::data("themes/puget-sound.ron"), Some(&map))
+        relume::load::themes::load_themes(&common::data("themes/puget-sound.ron"), Some(given))
             .unwrap();
     assert_map_view_matches(&gpu, &map, Some((&set, 3)));
 }

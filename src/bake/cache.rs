@@ -21,6 +21,7 @@
 use crate::baked::manifest::{hash_file, sha256_hex};
 use crate::baked::{self, BakeTransaction, FileRecord, StageRecord};
 use crate::error::{Error, IoContext, Result};
+use crate::heightmap::georef::GeoReference;
 use crate::pipeline::Stage;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -66,8 +67,9 @@ impl StageCache {
         &self.scope
     }
 
-    /// The key of `stage` run on a bake holding `files`.
-    pub fn key(stage: &Stage, files: &[FileRecord]) -> String {
+    /// The key of `stage` run on a bake holding `files`, over an input with georeference
+    /// `georef` (which places a `Themes` stage's georeferenced polygons).
+    pub fn key(stage: &Stage, files: &[FileRecord], georef: Option<&GeoReference>) -> String {
         let mut text = format!(
             "relume {} source {} format {}\n{}\n",
             env!("CARGO_PKG_VERSION"),
@@ -81,6 +83,9 @@ impl StageCache {
                 let digest =
                     hash_file(&f).map_or_else(|_| "unreadable".into(), |(n, h)| format!("{n} {h}"));
                 text += &format!("reads {} {digest}\n", f.display());
+            }
+            if let Some(g) = georef {
+                text += &format!("georeference {}\n", ron::to_string(g).expect("serialises"));
             }
         }
         let mut sorted: Vec<&FileRecord> = files.iter().collect();

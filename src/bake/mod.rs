@@ -109,6 +109,29 @@ fn check_stage_files(pipeline: &Pipeline) -> Result<()> {
     Ok(())
 }
 
+/// The checks of the `Themes` stages that need the loaded input (georeferenced polygons need the
+/// height map's georeference), made before any stage runs.
+fn check_stage_input(pipeline: &Pipeline, input: &LoadedInput) -> Result<()> {
+    let LoadedInput::HeightMap(map, info) = input else {
+        return Ok(());
+    };
+    let name = format!(
+        "the pipeline's height map `{}`",
+        pipeline.input.path().display()
+    );
+    for stage in &pipeline.stages {
+        if let Stage::Themes(k) = stage {
+            let given = crate::load::themes::GivenHeightMap {
+                map,
+                georef: info.georef.as_ref(),
+                name: &name,
+            };
+            crate::load::themes::check_heightmap(&k.file, given)?;
+        }
+    }
+    Ok(())
+}
+
 pub fn run_pipeline(
     pipeline: &Pipeline,
     output: &Path,
@@ -124,6 +147,7 @@ pub fn run_pipeline(
     check_stage_files(pipeline)?;
     progress.begin("load", 0);
     let input = load_input(&pipeline.input)?;
+    check_stage_input(pipeline, &input)?;
     progress.finish();
     let mut warnings = Vec::new();
     if let LoadedInput::Scene(_, w) = &input {
@@ -144,7 +168,10 @@ pub fn run_pipeline(
     ws.read_missing_from(txn.staging_dir());
     match input {
         LoadedInput::Scene(scene, _) => ws.set_scene(scene),
-        LoadedInput::HeightMap(map, _) => ws.set_heightmap(map),
+        LoadedInput::HeightMap(map, info) => {
+            ws.set_heightmap(map);
+            ws.set_georef(info.georef);
+        }
     }
     let cache = opts
         .cache
@@ -160,7 +187,7 @@ pub fn run_pipeline(
         let t = Instant::now();
         let mut stage_estimate = 0;
         let before = txn.files();
-        let key = StageCache::key(stage, &before);
+        let key = StageCache::key(stage, &before, ws.georef()?);
         let hit = cache
             .as_ref()
             .filter(|_| !opts.force)
@@ -427,6 +454,11 @@ fn write_input(txn: &mut BakeTransaction, input: &LoadedInput) -> Result<StageRe
                 format!("{} {}", info.format, info.sample),
             );
             rec.facts.insert("units".into(), "metres".into());
+            if let Some(g) = &info.georef {
+                let text = ron::to_string(g).expect("a georeference serialises");
+                let fact = baked::heightmap::GEOREFERENCE_FACT;
+                rec.facts.insert(fact.into(), text);
+            }
         }
     }
     Ok(rec)

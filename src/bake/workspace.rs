@@ -7,6 +7,7 @@ use crate::baked::form_factors::MappedFormFactors;
 use crate::baked::{self, form_factors::FormFactorMatrix, Manifest};
 use crate::compress::EncodedTransport;
 use crate::error::{Error, Result};
+use crate::heightmap::georef::GeoReference;
 use crate::heightmap::HeightMap;
 use crate::radiosity::{PatchSet, TransportMatrix};
 use crate::scene::Scene;
@@ -45,6 +46,8 @@ pub struct Workspace {
     memory_budget: Option<u64>,
     scene: Option<Scene>,
     heightmap: Option<HeightMap>,
+    /// The input height map's georeference: Some(None) when it has none, None when not known yet.
+    georef: Option<Option<GeoReference>>,
     patches: Option<PatchSet>,
     form_factors: Option<FormFactorMatrix>,
     transport: Option<TransportMatrix>,
@@ -148,6 +151,33 @@ impl Workspace {
     /// Store the height map for later stages.
     pub fn set_heightmap(&mut self, value: HeightMap) {
         self.heightmap = Some(value);
+    }
+
+    /// The input height map's georeference (None when it has none): as loaded in this run, else
+    /// the source bake's `load` record (fact `georeference`, RON).
+    pub fn georef(&mut self) -> Result<Option<&GeoReference>> {
+        if self.georef.is_none() {
+            let load = match &self.source {
+                Some((_, Some(manifest))) => manifest.stage("load"),
+                _ => None,
+            };
+            let fact = load.and_then(|r| r.facts.get(baked::heightmap::GEOREFERENCE_FACT));
+            let georef = match fact {
+                Some(text) => Some(ron::from_str(text).map_err(|e| {
+                    let (dir, _) = self.source.as_ref().unwrap();
+                    let why = format!("the `load` record's georeference does not parse: {e}");
+                    Error::input(dir.join(baked::MANIFEST), why)
+                })?),
+                None => None,
+            };
+            self.georef = Some(georef);
+        }
+        Ok(self.georef.as_ref().unwrap().as_ref())
+    }
+
+    /// Store the input height map's georeference for later stages.
+    pub fn set_georef(&mut self, value: Option<GeoReference>) {
+        self.georef = Some(value);
     }
 
     /// The scene and its patches together (each read on first use), for stages that need both.

@@ -9,6 +9,10 @@ use std::path::Path;
 /// File name of the height field in a height-map bake.
 pub const FILE: &str = "heightmap.exr";
 
+/// The `load` record's fact that keeps the input's georeference (a GeoTIFF's tags for the
+/// loaded grid, as RON), when it has one.
+pub const GEOREFERENCE_FACT: &str = "georeference";
+
 /// Write the height field into a bake.
 pub fn write(txn: &mut BakeTransaction, map: &HeightMap) -> Result<()> {
     txn.write_with(FILE, |p| write_file(p, map))

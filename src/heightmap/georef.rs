@@ -4,6 +4,7 @@
 //! f32), little-endian strips, BigTIFF past 2 GiB of samples. Texel (column j, row i) covers
 //! [j, j+1) × [i, i+1) in texel space, its centre at +0.5; row 0 is the file's first (north).
 
+use super::utm::{self, WGS84_A, WGS84_E2};
 use crate::error::{Error, Result}; // the same path in relume and in the scratch stand-in
 use std::io::{Read, Seek, Write};
 use std::path::Path;
@@ -15,7 +16,7 @@ use tiff::TiffResult;
 
 /// What a GeoTIFF says about where its grid lies: the raw GeoTIFF tags, kept so that an output
 /// can carry them unchanged. Empty fields mean the tag is absent.
-#[derive(Clone, Debug, PartialEq, Default, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct GeoReference {
     /// ModelTiepointTag (33922): (I, J, K, X, Y, Z) per tiepoint.
     pub tiepoints: Vec<f64>,
@@ -41,10 +42,6 @@ pub enum Crs {
     /// Anything else, with its EPSG code when the file names one.
     Other { epsg: Option<u16> },
 }
-
-const WGS84_A: f64 = 6378137.0;
-const WGS84_F: f64 = 1.0 / 298.257223563;
-const WGS84_E2: f64 = WGS84_F * (2.0 - WGS84_F);
 
 impl GeoReference {
     /// Reads the georeference tags from an opened decoder (None when the file has none of them).
@@ -141,17 +138,68 @@ impl GeoReference {
         p.iter().all(|v| v.is_finite()).then_some(p)
     }
 
+    /// The texel-space point (column, row; texel centres at +0.5) of model (map) coordinates
+    /// (x, y): the inverse of [`GeoReference::model_xy`], with the same raster-type convention
+    /// (PixelIsPoint adds the half texel back). None without the matrix or one tiepoint, or when
+    /// the affine map is singular.
+    pub fn texel_of_model(&self, x: f64, y: f64) -> Option<[f64; 2]> {
+        let half = if self.key(1025) == Some(2) { 0.5 } else { 0.0 };
+        let (t, s, m) = (&self.tiepoints, &self.pixel_scale, &self.transformation);
+        let [i, j] = if m.len() == 16 {
+            // [x − m3, y − m7] = [[m0, m1], [m4, m5]]·[i, j], solved by Cramer's rule.
+            let (dx, dy, det) = (x - m[3], y - m[7], m[0] * m[5] - m[1] * m[4]);
+            [(m[5] * dx - m[1] * dy) / det, (m[0] * dy - m[4] * dx) / det]
+        } else if t.len() == 6 && s.len() >= 2 {
+            [t[0] + (x - t[3]) / s[0], t[1] + (t[4] - y) / s[1]]
+        } else {
+            return None;
+        };
+        let p = [i + half, j + half];
+        p.iter().all(|v| v.is_finite()).then_some(p)
+    }
+
+    /// Whether [`GeoReference::lat_lon`] and [`GeoReference::texel_of_lat_lon`] understand the
+    /// CRS: geographic in degrees (GeogAngularUnitsGeoKey 2054 absent or 9102), or UTM.
+    pub fn reads_lat_lon(&self) -> bool {
+        match self.crs() {
+            Crs::Geographic => matches!(self.key(2054), None | Some(9102)),
+            Crs::Utm { zone, .. } => (1..=60).contains(&zone),
+            Crs::Other { .. } => false,
+        }
+    }
+
     /// Latitude and longitude (degrees) of texel-space point, for Geographic and UTM CRSs; None
-    /// for Other. Inverse UTM on WGS 84: Krüger's series to 6th order in n, then the geodetic
-    /// latitude from the conformal one by Newton's method (Karney 2011, "Transverse Mercator with
-    /// an accuracy of a few nanometers", J. Geod. 85:475): a few nm within 3900 km of the meridian.
+    /// for Other. UTM by [`utm::inverse`] (Krüger's series to 6th order in n, a few nm).
     pub fn lat_lon(&self, col: f64, row: f64) -> Option<[f64; 2]> {
         let [x, y] = self.model_xy(col, row)?;
         match self.crs() {
-            // GeogAngularUnitsGeoKey (2054): degrees (9102), the default, are all relume reads.
-            Crs::Geographic if matches!(self.key(2054), None | Some(9102)) => Some([y, x]),
-            Crs::Utm { zone, north } if zone <= 60 => Some(utm_inverse(zone, north, x, y)),
-            _ => None,
+            _ if !self.reads_lat_lon() => None,
+            Crs::Utm { zone, north } => Some(utm::inverse(zone, north, x, y)),
+            _ => Some([y, x]),
+        }
+    }
+
+    /// The texel-space point of latitude and longitude (degrees, taken as WGS 84): forward UTM
+    /// ([`utm::forward`], in the grid's zone) or the degrees themselves, then
+    /// [`GeoReference::texel_of_model`]. On a geographic grid of `size` (width, height) the
+    /// longitude is moved by whole turns to within 180° of the grid centre's, so that a 0..360°
+    /// grid reads −170° as 190°. None when [`GeoReference::reads_lat_lon`] is false.
+    pub fn texel_of_lat_lon(&self, lat: f64, lon: f64, size: [usize; 2]) -> Option<[f64; 2]> {
+        match self.crs() {
+            _ if !self.reads_lat_lon() => None,
+            Crs::Utm { zone, north } => {
+                let [x, y] = utm::forward(zone, north, lat, lon);
+                self.texel_of_model(x, y)
+            }
+            _ => {
+                let [cx, _] = self.model_xy(size[0] as f64 / 2.0, size[1] as f64 / 2.0)?;
+                let turns = if (lon - cx).abs() <= 180.0 {
+                    0.0
+                } else {
+                    ((lon - cx) / 360.0).round()
+                };
+                self.texel_of_model(lon - 360.0 * turns, lat)
+            }
         }
     }
 
@@ -198,52 +246,6 @@ impl GeoReference {
 fn tag<R: Read + Seek, T: Default>(d: &mut Decoder<R>, t: Tag, f: fn(Value) -> TiffResult<T>) -> T {
     let value = d.find_tag(t).ok().flatten();
     value.and_then(|v| f(v).ok()).unwrap_or_default()
-}
-
-/// Inverse UTM on WGS 84: (easting, northing) in metres to [latitude, longitude] in degrees.
-fn utm_inverse(zone: u8, north: bool, easting: f64, northing: f64) -> [f64; 2] {
-    const K0: f64 = 0.9996;
-    let n = WGS84_F / (2.0 - WGS84_F);
-    let [n2, n3, n4, n5, n6] = [2, 3, 4, 5, 6].map(|k| n.powi(k));
-    let a = WGS84_A / (1.0 + n) * (1.0 + n2 / 4.0 + n4 / 64.0 + n6 / 256.0);
-    let beta = [
-        n / 2.0 - 2.0 * n2 / 3.0 + 37.0 * n3 / 96.0 - n4 / 360.0 - 81.0 * n5 / 512.0
-            + 96199.0 * n6 / 604800.0,
-        n2 / 48.0 + n3 / 15.0 - 437.0 * n4 / 1440.0 + 46.0 * n5 / 105.0
-            - 1118711.0 * n6 / 3870720.0,
-        17.0 * n3 / 480.0 - 37.0 * n4 / 840.0 - 209.0 * n5 / 4480.0 + 5569.0 * n6 / 90720.0,
-        4397.0 * n4 / 161280.0 - 11.0 * n5 / 504.0 - 830251.0 * n6 / 7257600.0,
-        4583.0 * n5 / 161280.0 - 108847.0 * n6 / 3991680.0,
-        20648693.0 * n6 / 638668800.0,
-    ];
-    let xi = (northing - if north { 0.0 } else { 10_000_000.0 }) / (K0 * a);
-    let eta = (easting - 500_000.0) / (K0 * a);
-    let (mut xp, mut ep) = (xi, eta);
-    for (j, b) in beta.iter().enumerate() {
-        let k = 2.0 * (j + 1) as f64;
-        xp -= b * (k * xi).sin() * (k * eta).cosh();
-        ep -= b * (k * xi).cos() * (k * eta).sinh();
-    }
-    // Tangent of the conformal latitude, then of the geodetic latitude by Newton's method.
-    let taup = xp.sin() / ep.sinh().hypot(xp.cos());
-    let (e2, e) = (WGS84_E2, WGS84_E2.sqrt());
-    let lat = if taup.is_finite() {
-        let mut tau = taup / (1.0 - e2);
-        for _ in 0..5 {
-            // quadratic convergence from τ'/(1 − e²): two steps reach double precision
-            let tau1 = tau.hypot(1.0);
-            let sig = (e * (e * tau / tau1).atanh()).sinh();
-            let taupa = tau * sig.hypot(1.0) - sig * tau1;
-            let dtau = (taup - taupa) * (1.0 + (1.0 - e2) * tau * tau)
-                / ((1.0 - e2) * tau1 * taupa.hypot(1.0));
-            tau += dtau;
-        }
-        tau.atan().to_degrees()
-    } else {
-        90f64.copysign(taup)
-    };
-    let lon = f64::from(zone) * 6.0 - 183.0 + ep.sinh().atan2(xp.cos()).to_degrees();
-    [lat, 180.0 - (180.0 - lon).rem_euclid(360.0)] // in (-180, 180]
 }
 
 /// Opens `path` and returns its georeference (None when it has no GeoTIFF tags).

@@ -13,6 +13,7 @@
 pub mod georef;
 pub mod minmax_mipmap;
 mod readers;
+pub mod utm;
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

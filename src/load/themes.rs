@@ -4,8 +4,10 @@
 
 use crate::error::ron_located::{located, RonFormat};
 use crate::error::{Error, IoContext, Result};
+use crate::heightmap::georef::GeoReference;
 use crate::heightmap::HeightMap;
 use crate::theme::index_map::{self, IndexMap, Polygon, Rule};
+use crate::theme::place::Placement;
 use crate::theme::spec::{Coordinates, MapSpec, TextureSource, ThemeSpec};
 use crate::theme::{Border, Class, ThemeSet, MAX_CLASSES};
 use ron::extensions::Extensions;
@@ -29,10 +31,23 @@ pub fn parse_themes(path: &Path, text: &str) -> Result<ThemeSpec> {
     Ok(spec)
 }
 
+/// A height map handed to the loader in place of the one the theme file names, with its
+/// georeference: a pipeline's `Themes` stage passes the pipeline's, so that the classes follow
+/// the baked relief texel for texel and georeferenced polygons land where the relief is.
+#[derive(Clone, Copy, Debug)]
+pub struct GivenHeightMap<'a> {
+    pub map: &'a HeightMap,
+    /// Its georeference (a GeoTIFF's tags, for the loaded grid), which places `LonLat` and
+    /// `Map` polygons; None when it has none.
+    pub georef: Option<&'a GeoReference>,
+    /// What it is, for messages ("the pipeline's height map `dem.tif`").
+    pub name: &'a str,
+}
+
 /// Load the theme set at `path`. `heightmap`, when given, is the height map a `Rules` map
-/// classifies, in place of the one the file names: a pipeline's `Themes` stage passes the
-/// pipeline's, so that the classes follow the baked relief texel for texel.
-pub fn load_themes(path: &Path, heightmap: Option<&HeightMap>) -> Result<ThemeSet> {
+/// classifies and whose georeference places `LonLat`/`Map` polygons, in place of the one the
+/// file names.
+pub fn load_themes(path: &Path, heightmap: Option<GivenHeightMap>) -> Result<ThemeSet> {
     let text = std::fs::read_to_string(path).at(path, "cannot read theme set")?;
     let spec = parse_themes(path, &text)?;
     let dir = path.parent().unwrap_or(Path::new("."));
@@ -46,6 +61,23 @@ pub fn load_themes(path: &Path, heightmap: Option<&HeightMap>) -> Result<ThemeSe
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(spec.assemble(map, extra, &pngs))
+}
+
+/// Check, before any work, that the theme set at `path` can be loaded over `heightmap`: that
+/// polygons in `LonLat` or `Map` coordinates have the georeference they need (a pipeline calls
+/// this for each `Themes` stage right after loading its input).
+pub fn check_heightmap(path: &Path, heightmap: GivenHeightMap) -> Result<()> {
+    let text = std::fs::read_to_string(path).at(path, "cannot read theme set")?;
+    let spec = parse_themes(path, &text)?;
+    if let MapSpec::Polygons {
+        size, coordinates, ..
+    } = &spec.map
+    {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let grid = polygon_grid(path, dir, &spec.map, Some(heightmap))?;
+        placement(path, *coordinates, *size, &grid)?;
+    }
+    Ok(())
 }
 
 /// The files a theme set reads (itself first, then what it names), for content-keyed
@@ -65,8 +97,8 @@ pub fn theme_files(path: &Path) -> Vec<PathBuf> {
         } => out.push(dir.join(h)),
         MapSpec::Image { path: p, .. } => out.push(dir.join(p)),
         MapSpec::Polygons {
-            geojson: Some(g), ..
-        } => out.push(dir.join(g)),
+            geojson, heightmap, ..
+        } => out.extend(geojson.iter().chain(heightmap).map(|f| dir.join(f))),
         _ => {}
     }
     for t in &spec.themes {
@@ -77,11 +109,80 @@ pub fn theme_files(path: &Path) -> Vec<PathBuf> {
     out
 }
 
+/// What places the polygons of a `Polygons` map in `LonLat`/`Map` coordinates: the given height
+/// map's georeference, else that of the file's `heightmap` (loaded here), with the height map's
+/// size and its name for messages. None for other maps and coordinates.
+type Grid = Option<(Option<GeoReference>, [usize; 2], String)>;
+
+fn polygon_grid(
+    path: &Path,
+    dir: &Path,
+    map: &MapSpec,
+    given: Option<GivenHeightMap>,
+) -> Result<Grid> {
+    let MapSpec::Polygons {
+        coordinates,
+        heightmap,
+        ..
+    } = map
+    else {
+        return Ok(None);
+    };
+    if !coordinates.georeferenced() {
+        return Ok(None);
+    }
+    Ok(Some(match (given, heightmap) {
+        (Some(g), _) => (
+            g.georef.cloned(),
+            [g.map.width, g.map.height],
+            g.name.to_string(),
+        ),
+        (None, Some(file)) => {
+            let file = dir.join(file);
+            let (m, info) = crate::load::heightmap_input_with_info(&file, None, None)?;
+            let name = format!("the height map `{}`", file.display());
+            (info.georef, [m.width, m.height], name)
+        }
+        (None, None) => {
+            return Err(Error::input(
+                path,
+                format!(
+                    "polygons in `{coordinates:?}` coordinates need a georeferenced height map: \
+                     name one (`heightmap: \"dem.tif\"`, relative to this file, or a height-map \
+                     pipeline), pass `--heightmap`, or bake the set in a height-map pipeline's \
+                     `Themes` stage"
+                ),
+            ))
+        }
+    }))
+}
+
+/// The placement of polygon vertices on an index map of `size`; the error names the theme file,
+/// the height map and why it cannot place them.
+fn placement<'a>(
+    path: &Path,
+    coordinates: Coordinates,
+    size: (usize, usize),
+    grid: &'a Grid,
+) -> Result<Placement<'a>> {
+    let (georef, dims) = match grid {
+        Some((g, dims, _)) => (g.as_ref(), *dims),
+        None => (None, [1, 1]),
+    };
+    Placement::new(coordinates, size, (georef, dims)).map_err(|why| {
+        let name = grid.as_ref().map_or("", |g| g.2.as_str());
+        Error::input(
+            path,
+            format!("cannot place polygons in `{coordinates:?}` coordinates: {name} {why}"),
+        )
+    })
+}
+
 fn index_map_of(
     path: &Path,
     dir: &Path,
     spec: &ThemeSpec,
-    given: Option<&HeightMap>,
+    given: Option<GivenHeightMap>,
 ) -> Result<(IndexMap, Vec<Class>)> {
     let theme = |name: &str| spec.theme_index(name).map_err(|m| Error::input(path, m));
     match &spec.map {
@@ -92,7 +193,7 @@ fn index_map_of(
         } => {
             let loaded;
             let map = match (heightmap, given) {
-                (_, Some(m)) => m,
+                (_, Some(m)) => m.map,
                 (Some(file), None) => {
                     loaded = crate::load::heightmap_input(&dir.join(file), None, None)?;
                     &loaded
@@ -155,24 +256,26 @@ fn index_map_of(
             size,
             background,
             coordinates,
+            ..
         } => {
-            let scale = match coordinates {
-                Coordinates::Texels => [1.0, 1.0],
-                Coordinates::Unit => [size.0 as f64, size.1 as f64],
-            };
-            let mut list: Vec<Feature> = vec![];
+            // The georeference first: a missing one stops the load before any file is read.
+            let grid = polygon_grid(path, dir, &spec.map, given)?;
+            let place = placement(path, *coordinates, *size, &grid)?;
+            let mut list: Vec<(PathBuf, Feature)> = vec![];
             if let Some(file) = geojson {
-                list.extend(read_geojson(&dir.join(file))?);
+                let file = dir.join(file);
+                let features = read_geojson(&file)?;
+                list.extend(features.into_iter().map(|f| (file.clone(), f)));
             }
-            list.extend(
-                polygons
-                    .iter()
-                    .map(|p| (p.theme.clone(), p.border, p.rings.clone())),
-            );
+            list.extend(polygons.iter().enumerate().map(|(k, p)| {
+                let at = format!("polygon {k} of `polygons`");
+                let f = (at, p.theme.clone(), p.border, p.rings.clone());
+                (path.to_path_buf(), f)
+            }));
             let mut extra: Vec<Class> = vec![];
             let base = spec.classes();
             let mut out = Vec::with_capacity(list.len());
-            for (name, border, rings) in list {
+            for (from, (at, name, border, rings)) in list {
                 let t = theme(&name)?;
                 let class = match border {
                     None => t,
@@ -201,12 +304,9 @@ fn index_map_of(
                 };
                 let rings = rings
                     .into_iter()
-                    .map(|r| {
-                        r.into_iter()
-                            .map(|p| [p[0] * scale[0], p[1] * scale[1]])
-                            .collect()
-                    })
-                    .collect();
+                    .map(|r| r.into_iter().map(|p| place.texel(p)).collect())
+                    .collect::<std::result::Result<_, String>>()
+                    .map_err(|m| Error::input(&from, format!("{at}: {m}")))?;
                 out.push(Polygon { class, rings });
             }
             Ok((
@@ -228,7 +328,8 @@ fn parse_hex(key: &str) -> std::result::Result<[u8; 3], String> {
     Ok([byte(0)?, byte(2)?, byte(4)?])
 }
 
-type Feature = (String, Option<Border>, Vec<Vec<[f64; 2]>>);
+/// Where a polygon came from ("feature 3"), its theme, its own border, its rings.
+type Feature = (String, String, Option<Border>, Vec<Vec<[f64; 2]>>);
 
 /// The polygons of a GeoJSON FeatureCollection: `Polygon` and `MultiPolygon` geometries, each
 /// feature with a `theme` property and optionally `border`: {"kind": "fractal", "amplitude": 4,
@@ -281,7 +382,7 @@ fn read_geojson(path: &Path) -> Result<Vec<Feature>> {
                         .collect::<Result<Vec<_>>>()
                 })
                 .collect::<Result<Vec<_>>>()?;
-            out.push((theme.clone(), border, rings));
+            out.push((format!("feature {i}"), theme.clone(), border, rings));
         }
     }
     Ok(out)

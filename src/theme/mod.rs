@@ -10,7 +10,9 @@
 //! tiling).
 //!
 //! One file per piece: [`noise`] (the turbulence map), [`index_map`] (the class map from
-//! height/slope/aspect rules, from an image, or rasterised from polygons), [`mip`] (index
+//! height/slope/aspect rules, from an image, or rasterised from polygons), [`place`] (polygon
+//! vertices from texels, the unit square, longitude/latitude or map coordinates to index
+//! texels, through a height map's georeference), [`mip`] (index
 //! levels that never blend: a coarser texel keeps what wholly covers it), [`ccc`] (Colour Cell
 //! Compression of the index map, made lossless by an exception table), [`textures`] (the
 //! procedural tileable theme textures and their mip chains), [`compose`] (the lookup and the
@@ -21,6 +23,7 @@ pub mod compose;
 pub mod index_map;
 pub mod mip;
 pub mod noise;
+pub mod place;
 pub mod spec;
 pub mod textures;
 

@@ -102,6 +102,9 @@ pub enum MapSpec {
     },
     /// Polygons (a GeoJSON FeatureCollection with a `theme` property per feature, and an
     /// optional `border`; and/or inline polygons) rasterised at `size` over `background`.
+    /// `heightmap` (relative to the theme file, or a height-map pipeline) is the georeferenced
+    /// height map that places `LonLat` and `Map` coordinates; a pipeline's `Themes` stage uses
+    /// the pipeline's height map instead.
     Polygons {
         #[serde(default)]
         geojson: Option<String>,
@@ -111,6 +114,8 @@ pub enum MapSpec {
         background: String,
         #[serde(default)]
         coordinates: Coordinates,
+        #[serde(default)]
+        heightmap: Option<String>,
     },
 }
 
@@ -146,6 +151,18 @@ pub enum Coordinates {
     Texels,
     /// The unit square, x east, y south.
     Unit,
+    /// Longitude, latitude in degrees on WGS 84 (RFC 7946, the GeoJSON default), placed by the
+    /// georeference of a geographic or UTM height map.
+    LonLat,
+    /// The georeferenced height map's own CRS (x, y in its units, e.g. UTM metres).
+    Map,
+}
+
+impl Coordinates {
+    /// Does this need a georeferenced height map?
+    pub fn georeferenced(self) -> bool {
+        matches!(self, Coordinates::LonLat | Coordinates::Map)
+    }
 }
 
 impl ThemeSpec {
@@ -190,11 +207,24 @@ impl ThemeSpec {
         for name in self.referenced() {
             self.theme_index(name)?;
         }
-        if let MapSpec::Polygons { size, .. } = &self.map {
+        if let MapSpec::Polygons {
+            size,
+            coordinates,
+            heightmap,
+            ..
+        } = &self.map
+        {
             if size.0 == 0 || size.1 == 0 || size.0 > 65536 || size.1 > 65536 {
                 return Err(format!(
                     "polygons `size` must be 1..=65536 per side, got {}x{}",
                     size.0, size.1
+                ));
+            }
+            if heightmap.is_some() && !coordinates.georeferenced() {
+                return Err(format!(
+                    "polygons in `{coordinates:?}` coordinates read no `heightmap` (it places \
+                     `LonLat` and `Map` coordinates only): remove it, or give \
+                     `coordinates: LonLat` or `Map`"
                 ));
             }
         }

@@ -120,7 +120,13 @@ impl StageRun for ThemesKnobs {
         progress: &dyn Progress,
     ) -> Result<StageRecord> {
         progress.begin(baked::themes::STAGE, 0);
-        let set = crate::load::themes::load_themes(&self.file, Some(ws.heightmap()?))?;
+        let georef = ws.georef()?.cloned();
+        let given = crate::load::themes::GivenHeightMap {
+            map: ws.heightmap()?,
+            georef: georef.as_ref(),
+            name: "the pipeline's height map",
+        };
+        let set = crate::load::themes::load_themes(&self.file, Some(given))?;
         baked::themes::write(txn, &set)?;
         progress.finish();
         let mut rec = record(baked::themes::STAGE, &[baked::themes::FILE]);

@@ -4,7 +4,7 @@
 use crate::ui::Ui;
 use clap::Args;
 use relume::baked::images::{check_extension, write_png_rgba};
-use relume::load::themes::load_themes;
+use relume::load::themes::{load_themes, GivenHeightMap};
 use relume::render::tonemap::linear_to_srgb8;
 use relume::theme::compose::compose;
 use relume::{Error, Result};
@@ -15,8 +15,9 @@ use std::time::Instant;
 const THEME_HELP: &str = "\
 Theme sets are RON (themes/*.ron); the format is in docs/themes.md. The index map comes from
 height/slope/aspect rules over a height map, from a key image, or from polygons (GeoJSON or
-inline). The albedo is written in sRGB; --frame K moves the fractal borders as frame K of the
-animation does in the player.";
+inline; in texels, the unit square, longitude/latitude or the height map's CRS). The albedo is
+written in sRGB; --frame K moves the fractal borders as frame K of the animation does in the
+player.";
 
 #[derive(Args)]
 #[command(after_help = THEME_HELP)]
@@ -32,7 +33,8 @@ pub struct ThemeArgs {
     /// Animation frame (the border noise shifted K times)
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub frame: u32,
-    /// Height map (or height-map pipeline) for a `Rules` map that names none
+    /// Height map (or height-map pipeline) in place of the one the theme file names: the one a
+    /// `Rules` map classifies, whose georeference places `LonLat`/`Map` polygons
     #[arg(long, value_name = "FILE")]
     pub heightmap: Option<PathBuf>,
 }
@@ -40,11 +42,17 @@ pub struct ThemeArgs {
 pub fn run(a: &ThemeArgs, ui: &Ui, json_out: bool) -> Result<i32> {
     check_extension(&a.out, &["png"])?;
     let map = match &a.heightmap {
-        Some(p) => Some(relume::load::heightmap_input(p, None, None)?),
+        Some(p) => Some(relume::load::heightmap_input_with_info(p, None, None)?),
         None => None,
     };
+    let name = a.heightmap.as_ref().map(|p| format!("`{}`", p.display()));
+    let given = map.as_ref().map(|(map, info)| GivenHeightMap {
+        map,
+        georef: info.georef.as_ref(),
+        name: name.as_deref().unwrap_or_default(),
+    });
     let t0 = Instant::now();
-    let set = load_themes(&a.themes, map.as_ref())?;
+    let set = load_themes(&a.themes, given)?;
     let load_s = t0.elapsed().as_secs_f64();
     let base = &set.index.levels[0];
     let width = a.size as usize;
