@@ -81,7 +81,17 @@ pub fn bind(
     pipeline: &wgpu::ComputePipeline,
     resources: &[wgpu::BindingResource<'_>],
 ) -> wgpu::BindGroup {
-    let layout = pipeline.get_bind_group_layout(0);
+    bind_group(gpu, pipeline, 0, resources)
+}
+
+/// Bind `resources` (binding i = resources[i]) to group `group` of `pipeline`.
+pub fn bind_group(
+    gpu: &Gpu,
+    pipeline: &wgpu::ComputePipeline,
+    group: u32,
+    resources: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let layout = pipeline.get_bind_group_layout(group);
     let entries: Vec<wgpu::BindGroupEntry> = resources
         .iter()
         .enumerate()

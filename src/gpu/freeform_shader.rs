@@ -52,19 +52,7 @@ pub struct FreeformShader {
 
 /// Group 3 of `pipeline` over (parameters, sky view, aerial volume).
 fn air_bind(gpu: &Gpu, pipeline: &wgpu::ComputePipeline, b: [&wgpu::Buffer; 3]) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> = b
-        .iter()
-        .enumerate()
-        .map(|(i, buf)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: buf.as_entire_binding(),
-        })
-        .collect();
-    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("freeform air"),
-        layout: &pipeline.get_bind_group_layout(3),
-        entries: &entries,
-    })
+    compute::bind_group(gpu, pipeline, 3, &b.map(|x| x.as_entire_binding()))
 }
 
 impl FreeformShader {
