@@ -33,6 +33,8 @@ pub mod sun;
 pub mod sunlight;
 pub mod sweep;
 pub mod sweep_bound;
+pub mod sweep_exact;
+pub mod sweep_near;
 
 pub use minmax_mipmap::MinMaxMipmap;
 pub use sun::{Sun, Track, TrackKind};
