@@ -39,7 +39,7 @@ use super::accelerated_traversal::shadowed_accelerated;
 use super::exact_traversal::shadowed_exact;
 use super::minmax_mipmap::MinMaxMipmap;
 use super::sun::{Track, TrackKind};
-use super::sweep_bound::{directional_bound, transpose};
+use super::sweep_bound::{directional_bound, height_range, transpose};
 use super::sweep_exact::{witness, Walk};
 use super::sweep_near::{decide, Axes, NearStencil};
 use crate::heightmap::HeightMap;
@@ -75,6 +75,12 @@ impl SweepStats {
 const K: i64 = 2;
 /// Bands per parallel work item.
 const CHUNK: i64 = 1024;
+/// Major-axis lines (the own one and those after it) tested exactly before the bound: for a
+/// sun below LOW_SUN (tan 20°) LINES_LOW, where the bound is weak near the pixel (the ray
+/// rises little per line), else LINES (Puget Sound, benches/terrain_sweep.rs).
+const LINES: i64 = 2;
+const LINES_LOW: i64 = 8;
+const LOW_SUN: f64 = 0.364;
 
 /// The shadow mask (row-major, `true` = shadowed), equal to the exact traversal's on every
 /// pixel. `mip` speeds up the traversal of undecided pixels (the plain exact traversal without).
@@ -90,14 +96,15 @@ pub fn shadow_mask_sweep(
         TrackKind::Ray => {}
     }
     let frame = Frame::new(map, track);
-    let mask: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
+    let mut mask: Vec<AtomicU8> = Vec::with_capacity(n);
+    mask.par_extend((0..n).into_par_iter().map(|_| AtomicU8::new(0)));
     let (jmin, jmax) = frame.band_range();
     let starts: Vec<i64> = (jmin..=jmax).step_by(CHUNK as usize).collect();
     let stats = starts
         .par_iter()
         .map(|&j0| frame.sweep_bands(map, mip, j0, (j0 + CHUNK).min(jmax + 1), &mask))
         .reduce(SweepStats::default, SweepStats::add);
-    let mask = mask.into_iter().map(|v| v.into_inner() != 0).collect();
+    let mask = mask.into_par_iter().map(|v| v.into_inner() != 0).collect();
     (mask, stats)
 }
 
@@ -119,8 +126,9 @@ struct Frame<'a> {
     eps: f64,
     /// The map's largest height (the plain traversal's early stop).
     max_height: f32,
-    /// The exact test of the own and next lines' texels, for whole rows.
+    /// The exact test of the texels of the first `lines` lines, for whole rows.
     near: NearStencil,
+    lines: i64,
 }
 
 impl<'a> Frame<'a> {
@@ -134,9 +142,11 @@ impl<'a> Frame<'a> {
             (map.width, map.height, z, track.ux, track.uy)
         };
         // The canonical grid's bilinear surface is the map's, transposed: D is the same bound.
-        let d = directional_bound(&z, w, h, track.rise_per_t * ucx, track.rise_per_t * ucy);
+        let (lo, hi) = height_range(&map.heights);
+        let peak = lo.abs().max(hi.abs());
+        let (rx, ry) = (track.rise_per_t * ucx, track.rise_per_t * ucy);
+        let d = directional_bound(&z, w, h, rx, ry, peak);
         let rise = track.rise_per_t;
-        let (lo, hi) = map.min_max();
         let span = (map.width + map.height) as f64 + 2.0;
         let eps = 1e-9 * ((lo as f64).abs().max((hi as f64).abs()) + rise * span) + 1e-12;
         let (sx, sy) = (track.step_x, track.step_y);
@@ -151,7 +161,12 @@ impl<'a> Frame<'a> {
                 y: (track.uy, sy, track.inv_uy),
             }
         };
-        let near = NearStencil::new(axes, rise, 2, hi as f64 - lo as f64);
+        let lines = if track.tan_elevation < LOW_SUN {
+            LINES_LOW
+        } else {
+            LINES
+        };
+        let near = NearStencil::new(axes, rise, lines, hi as f64 - lo as f64);
         Frame {
             track,
             transposed,
@@ -166,6 +181,7 @@ impl<'a> Frame<'a> {
             eps,
             max_height: hi,
             near,
+            lines,
         }
     }
 
@@ -208,15 +224,16 @@ impl<'a> Frame<'a> {
         mask: &[AtomicU8],
     ) -> SweepStats {
         let q0 = j0.div_euclid(K);
+        let slots = (self.lines - 1) as usize;
         let nq = (j1 - j0 + K - 1) as usize / K as usize;
         let mut bands = Bands {
             q0,
             nq,
             best2: vec![f64::NEG_INFINITY; K as usize * nq],
             row2: vec![u32::MAX; K as usize * nq],
-            prev: vec![f64::NEG_INFINITY; K as usize * nq],
+            prev: vec![f64::NEG_INFINITY; slots * K as usize * nq],
         };
-        let mut prev_row = u32::MAX;
+        let mut prev_row = vec![u32::MAX; slots];
         // Scratch: the row's g = D − rise·x·u_x (padded), one window's maxima, the stencil.
         let mut gp = vec![f64::NEG_INFINITY; nq + 8];
         let mut wmax = vec![f64::NEG_INFINITY; nq];
@@ -226,6 +243,8 @@ impl<'a> Frame<'a> {
         let kx = self.rise * self.ucx;
         for step in 0..self.h {
             let y = if up { self.h - 1 - step } else { step };
+            // The ring slot of the row `lines − 1` steps back (it joins best2 now).
+            let slot = step % slots;
             self.decide_row(map, mip, y, j0, j1, &bands, &mut near, mask, &mut stats);
             // Rows beyond the next one of the rows still to come: the previous row joins.
             // This row's window values: for band j = K·q + s the maximum of g over
@@ -239,28 +258,36 @@ impl<'a> Frame<'a> {
             }
             let x_first = q0 + omin;
             let drow = &self.d[y * self.w..(y + 1) * self.w];
-            for (t, g) in gp[..len].iter_mut().enumerate() {
-                let x = x_first + t as i64;
-                *g = if x >= 0 && x < self.w as i64 {
-                    drow[x as usize] as f64 - kx * (x as f64 + 0.5)
-                } else {
-                    f64::NEG_INFINITY
-                };
+            // Columns x_first + t for t in ta..tb lie on the map.
+            let ta = (-x_first).clamp(0, len as i64) as usize;
+            let tb = (self.w as i64 - x_first).clamp(ta as i64, len as i64) as usize;
+            gp[..ta].fill(f64::NEG_INFINITY);
+            gp[tb..len].fill(f64::NEG_INFINITY);
+            if ta < tb {
+                let xa = (x_first + ta as i64) as usize;
+                for (t, (g, &dv)) in gp[ta..tb].iter_mut().zip(&drow[xa..]).enumerate() {
+                    *g = dv as f64 - kx * ((xa + t) as f64 + 0.5);
+                }
             }
+            // Only bands ra..rb have a window on the map in this row.
+            let ra = (-hi[K as usize - 1] - q0).clamp(0, nq as i64) as usize;
+            let rb = (self.w as i64 - lo[0] - q0).clamp(ra as i64, nq as i64) as usize;
             for s in 0..K as usize {
                 wmax.fill(f64::NEG_INFINITY);
                 for o in lo[s]..=hi[s] {
-                    let g = &gp[(o - omin) as usize..][..nq];
-                    for (m, &g) in wmax.iter_mut().zip(g) {
+                    let g = &gp[(o - omin) as usize + ra..][..rb - ra];
+                    for (m, &g) in wmax[ra..rb].iter_mut().zip(g) {
                         *m = if g > *m { g } else { *m };
                     }
                 }
                 let r = s * nq..(s + 1) * nq;
+                let pr = (slot * K as usize + s) * nq..(slot * K as usize + s + 1) * nq;
                 let (best2, row2, prev) = (
                     &mut bands.best2[r.clone()],
-                    &mut bands.row2[r.clone()],
-                    &mut bands.prev[r],
+                    &mut bands.row2[r],
+                    &mut bands.prev[pr],
                 );
+                let prev_row = prev_row[slot];
                 for i in 0..nq {
                     let p = prev[i];
                     if p > best2[i] {
@@ -270,7 +297,7 @@ impl<'a> Frame<'a> {
                     prev[i] = wmax[i] - row_term;
                 }
             }
-            prev_row = y as u32;
+            prev_row[slot] = y as u32;
         }
         stats
     }
@@ -311,8 +338,17 @@ impl<'a> Frame<'a> {
         }
         let zrow = &self.z[y * self.w..(y + 1) * self.w];
         let margin = self.near.margin;
+        let (rise, eps, ucx, ycy) = (self.rise, self.eps, self.ucx, (y as f64 + 0.5) * self.ucy);
         for x in x0..=x1 {
             let i = (band_base + x) as usize;
+            // The common case first: no texel of the first lines above the ray, bound below.
+            if xs <= x && x <= xe && near[(x - xs) as usize] < -margin {
+                let pu = (x as f64 + 0.5) * ucx + ycy;
+                if bands.best2[i] + rise * pu <= zrow[x as usize] as f64 - eps {
+                    stats.lit_by_bound += 1;
+                    continue;
+                }
+            }
             let (col, row) = if self.transposed {
                 (y, x as usize)
             } else {
@@ -333,7 +369,7 @@ impl<'a> Frame<'a> {
                 }
                 None => {
                     let mut walk = Walk::new(map, self.track, col, row, self.transposed);
-                    if walk.through_line() || walk.through_line() {
+                    if (0..self.lines).any(|_| walk.through_line()) {
                         stats.shadowed_near += 1;
                         true
                     } else {
