@@ -21,18 +21,26 @@
 //! [j/K, (j + 1)/K) (K = 2 bands per texel); in row y′ they cover the columns
 //! `⌊j/K + min(y′m, (y′+1)m) − δ⌋ ..= ⌊(j+1)/K + max(y′m, (y′+1)m) + δ⌋` (1 to 3 texels).
 //! Rows are visited from the sun's side; each band keeps the running maximum of
-//! D − rise·c·u over its window for the rows beyond the next one and beyond the current one.
+//! D − rise·c·u over its window for the rows at least L ahead of the current one (a ring of
+//! the last L − 1 rows' values delays them), and the row where that maximum lies. L = 8 lines
+//! for a sun below 20° (the ray rises little per line, so near texels defeat the bound), else
+//! 2. Band windows are computed only where they meet the map.
 //!
-//! **Per pixel, in order.** (1) Walk P's track exactly through its own row (the start texel,
-//! where t ≈ 0, defeats any bound): a texel above the ray means shadow. (2) The bound over the
-//! rows beyond: lit. (3) Walk on through the next row. (4) The bound over the rows beyond that:
-//! lit. (5) The texels of P's track in the row where its band's maximum lies, each with its
-//! exact transit — t_in = max(entry_x, entry_y), t_out = min(exit_x, exit_y), by the same
-//! [`Track::crossing`] expressions as the walk, so bit for bit its values; a texel passing the
-//! exact test is a witness: shadow. (6) The accelerated traversal.
+//! **Per pixel, in order.** (1) The texels of P's track in its first L lines (the start texel,
+//! where t ≈ 0, defeats any bound) by the near stencil ([`super::sweep_near`]): every track
+//! is an integer translate of every other, so their transits and bilinear weights are the same
+//! constants for all pixels and the exact test is a fixed stencil, evaluated in f32 for a
+//! whole row with a certified margin: above the margin, a texel passes the exact test
+//! (shadow); below −margin none does; between (near ties) and where a tap leaves the map, the
+//! scalar walk of those L lines ([`super::sweep_exact::Walk`]) decides. (2) The bound over the
+//! rows at least L ahead: lit. (3) The texels of P's track in the row where its band's maximum
+//! lies, each with its exact transit — t_in = max(entry_x, entry_y), t_out = min(exit_x,
+//! exit_y), by the same [`Track::crossing`] expressions as the walk, so bit for bit its values;
+//! a texel passing the exact test is a witness: shadow ([`super::sweep_exact::witness`]).
+//! (4) The accelerated traversal.
 //!
-//! Every "shadow" is an exact test the walking traversal also makes, every "lit" a bound with
-//! margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D is rounded up to f32).
+//! Every "shadow" is an exact test the walking traversal also makes (or the stencil's value
+//! beyond its error bound), every "lit" a bound with margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D is rounded up to f32).
 //! The answer of every pixel is exact, so it does not depend on the order or the threads.
 
 use super::accelerated_traversal::shadowed_accelerated;
@@ -58,6 +66,8 @@ pub struct SweepStats {
     pub shadowed_by_witness: u64,
     /// Left to the exact (accelerated) traversal.
     pub traversed: u64,
+    /// Of those, shadowed.
+    pub traversed_shadowed: u64,
 }
 
 impl SweepStats {
@@ -67,6 +77,7 @@ impl SweepStats {
             shadowed_near: self.shadowed_near + o.shadowed_near,
             shadowed_by_witness: self.shadowed_by_witness + o.shadowed_by_witness,
             traversed: self.traversed + o.traversed,
+            traversed_shadowed: self.traversed_shadowed + o.traversed_shadowed,
         }
     }
 }
@@ -411,10 +422,12 @@ impl<'a> Frame<'a> {
             return true;
         }
         stats.traversed += 1;
-        match mip {
+        let shadowed = match mip {
             Some(mip) => shadowed_accelerated(map, mip, self.track, col, row),
             None => shadowed_exact(map, self.track, col, row, self.max_height),
-        }
+        };
+        stats.traversed_shadowed += shadowed as u64;
+        shadowed
     }
 }
 
