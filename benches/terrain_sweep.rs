@@ -41,7 +41,7 @@ fn main() {
         "{} threads; wall times, best of 3 (floor: best of 5); shared machine: read the ratios.\n",
         rayon::current_num_threads()
     );
-    println!("| size | elevation | read floor | sweep | sweep / floor | A2 | A2 / sweep | lit by bound | shadowed near | shadowed by witness | traversed | differing vs A2 | differing vs exact |");
+    println!("| size | elevation | read floor | sweep | sweep / floor | A2 | A2 / sweep | lit by bound | shadowed near | shadowed by witness | traversed (shadowed) | differing vs A2 | differing vs exact |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut builds = Vec::new();
     for &n in &sizes {
@@ -84,7 +84,7 @@ fn main() {
             let px = mask.len() as f64;
             let pct = |v: u64| format!("{:.2} %", 100.0 * v as f64 / px);
             println!(
-                "| {n}² | {el}° | {:.2} ms | {:.1} ms | {:.1}x | {:.1} ms | {:.1}x | {} | {} | {} | {} | {differ} | {exact} |",
+                "| {n}² | {el}° | {:.2} ms | {:.1} ms | {:.1}x | {:.1} ms | {:.1}x | {} | {} | {} | {} ({}) | {differ} | {exact} |",
                 floor * 1e3,
                 ts * 1e3,
                 ts / floor,
@@ -94,6 +94,7 @@ fn main() {
                 pct(stats.shadowed_near),
                 pct(stats.shadowed_by_witness),
                 pct(stats.traversed),
+                pct(stats.traversed_shadowed),
             );
         }
     }

@@ -6,7 +6,9 @@
 //!   shape textures share it; stored by `crate::baked::mipmap`);
 //! - [`accelerated_traversal`]: hard shadows over the mipmap (algorithm A2), equal to the exact answer;
 //! - [`sweep`]: hard shadows by a certified sweep (bounds along bands, witnesses, exact
-//!   traversal for the rest), equal to the exact answer;
+//!   traversal for the rest), equal to the exact answer; [`sweep_bound`] its bound,
+//!   [`sweep_near`] the exact test of each track's first lines as a per-row stencil,
+//!   [`sweep_exact`] its scalar walk and witnesses;
 //! - [`horizon`]: horizon angles for N azimuths by a line sweep with convex hulls;
 //! - [`horizon_map`]: the quantised horizon map: sky-view factor, O(1) shadows for any sun;
 //! - [`hard_f32`]: f32 twins of the hard-shadow kernels (what a GPU port evaluates);
@@ -33,6 +35,8 @@ pub mod sun;
 pub mod sunlight;
 pub mod sweep;
 pub mod sweep_bound;
+pub mod sweep_exact;
+pub mod sweep_near;
 
 pub use minmax_mipmap::MinMaxMipmap;
 pub use sun::{Sun, Track, TrackKind};

@@ -21,25 +21,35 @@
 //! [j/K, (j + 1)/K) (K = 2 bands per texel); in row y′ they cover the columns
 //! `⌊j/K + min(y′m, (y′+1)m) − δ⌋ ..= ⌊(j+1)/K + max(y′m, (y′+1)m) + δ⌋` (1 to 3 texels).
 //! Rows are visited from the sun's side; each band keeps the running maximum of
-//! D − rise·c·u over its window for the rows beyond the next one and beyond the current one.
+//! D − rise·c·u over its window for the rows at least L ahead of the current one (a ring of
+//! the last L − 1 rows' values delays them), and the row where that maximum lies. L = 8 lines
+//! for a sun below 20° (the ray rises little per line, so near texels defeat the bound), else
+//! 2. Band windows are computed only where they meet the map.
 //!
-//! **Per pixel, in order.** (1) Walk P's track exactly through its own row (the start texel,
-//! where t ≈ 0, defeats any bound): a texel above the ray means shadow. (2) The bound over the
-//! rows beyond: lit. (3) Walk on through the next row. (4) The bound over the rows beyond that:
-//! lit. (5) The texels of P's track in the row where its band's maximum lies, each with its
-//! exact transit — t_in = max(entry_x, entry_y), t_out = min(exit_x, exit_y), by the same
-//! [`Track::crossing`] expressions as the walk, so bit for bit its values; a texel passing the
-//! exact test is a witness: shadow. (6) The accelerated traversal.
+//! **Per pixel, in order.** (1) The texels of P's track in its first L lines (the start texel,
+//! where t ≈ 0, defeats any bound) by the near stencil ([`super::sweep_near`]): every track
+//! is an integer translate of every other, so their transits and bilinear weights are the same
+//! constants for all pixels and the exact test is a fixed stencil, evaluated in f32 for a
+//! whole row with a certified margin: above the margin, a texel passes the exact test
+//! (shadow); below −margin none does; between (near ties) and where a tap leaves the map, the
+//! scalar walk of those L lines ([`super::sweep_exact::Walk`]) decides. (2) The bound over the
+//! rows at least L ahead: lit. (3) The texels of P's track in the row where its band's maximum
+//! lies, each with its exact transit — t_in = max(entry_x, entry_y), t_out = min(exit_x,
+//! exit_y), by the same [`Track::crossing`] expressions as the walk, so bit for bit its values;
+//! a texel passing the exact test is a witness: shadow ([`super::sweep_exact::witness`]).
+//! (4) The accelerated traversal.
 //!
-//! Every "shadow" is an exact test the walking traversal also makes, every "lit" a bound with
-//! margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D is rounded up to f32).
+//! Every "shadow" is an exact test the walking traversal also makes (or the stencil's value
+//! beyond its error bound), every "lit" a bound with margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D is rounded up to f32).
 //! The answer of every pixel is exact, so it does not depend on the order or the threads.
 
 use super::accelerated_traversal::shadowed_accelerated;
-use super::exact_traversal::{shadowed_exact, texel_sample, TrackWalk};
+use super::exact_traversal::shadowed_exact;
 use super::minmax_mipmap::MinMaxMipmap;
 use super::sun::{Track, TrackKind};
-use super::sweep_bound::{directional_bound, transpose};
+use super::sweep_bound::{directional_bound, height_range, transpose};
+use super::sweep_exact::{witness, Walk};
+use super::sweep_near::{decide, Axes, NearStencil};
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
 use std::borrow::Cow;
@@ -56,6 +66,8 @@ pub struct SweepStats {
     pub shadowed_by_witness: u64,
     /// Left to the exact (accelerated) traversal.
     pub traversed: u64,
+    /// Of those, shadowed.
+    pub traversed_shadowed: u64,
 }
 
 impl SweepStats {
@@ -65,6 +77,7 @@ impl SweepStats {
             shadowed_near: self.shadowed_near + o.shadowed_near,
             shadowed_by_witness: self.shadowed_by_witness + o.shadowed_by_witness,
             traversed: self.traversed + o.traversed,
+            traversed_shadowed: self.traversed_shadowed + o.traversed_shadowed,
         }
     }
 }
@@ -73,6 +86,12 @@ impl SweepStats {
 const K: i64 = 2;
 /// Bands per parallel work item.
 const CHUNK: i64 = 1024;
+/// Major-axis lines (the own one and those after it) tested exactly before the bound: for a
+/// sun below LOW_SUN (tan 20°) LINES_LOW, where the bound is weak near the pixel (the ray
+/// rises little per line), else LINES (Puget Sound, benches/terrain_sweep.rs).
+const LINES: i64 = 2;
+const LINES_LOW: i64 = 8;
+const LOW_SUN: f64 = 0.364;
 
 /// The shadow mask (row-major, `true` = shadowed), equal to the exact traversal's on every
 /// pixel. `mip` speeds up the traversal of undecided pixels (the plain exact traversal without).
@@ -88,14 +107,15 @@ pub fn shadow_mask_sweep(
         TrackKind::Ray => {}
     }
     let frame = Frame::new(map, track);
-    let mask: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
+    let mut mask: Vec<AtomicU8> = Vec::with_capacity(n);
+    mask.par_extend((0..n).into_par_iter().map(|_| AtomicU8::new(0)));
     let (jmin, jmax) = frame.band_range();
     let starts: Vec<i64> = (jmin..=jmax).step_by(CHUNK as usize).collect();
     let stats = starts
         .par_iter()
         .map(|&j0| frame.sweep_bands(map, mip, j0, (j0 + CHUNK).min(jmax + 1), &mask))
         .reduce(SweepStats::default, SweepStats::add);
-    let mask = mask.into_iter().map(|v| v.into_inner() != 0).collect();
+    let mask = mask.into_par_iter().map(|v| v.into_inner() != 0).collect();
     (mask, stats)
 }
 
@@ -117,6 +137,9 @@ struct Frame<'a> {
     eps: f64,
     /// The map's largest height (the plain traversal's early stop).
     max_height: f32,
+    /// The exact test of the texels of the first `lines` lines, for whole rows.
+    near: NearStencil,
+    lines: i64,
 }
 
 impl<'a> Frame<'a> {
@@ -130,11 +153,31 @@ impl<'a> Frame<'a> {
             (map.width, map.height, z, track.ux, track.uy)
         };
         // The canonical grid's bilinear surface is the map's, transposed: D is the same bound.
-        let d = directional_bound(&z, w, h, track.rise_per_t * ucx, track.rise_per_t * ucy);
+        let (lo, hi) = height_range(&map.heights);
+        let peak = lo.abs().max(hi.abs());
+        let (rx, ry) = (track.rise_per_t * ucx, track.rise_per_t * ucy);
+        let d = directional_bound(&z, w, h, rx, ry, peak);
         let rise = track.rise_per_t;
-        let (lo, hi) = map.min_max();
         let span = (map.width + map.height) as f64 + 2.0;
         let eps = 1e-9 * ((lo as f64).abs().max((hi as f64).abs()) + rise * span) + 1e-12;
+        let (sx, sy) = (track.step_x, track.step_y);
+        let axes = if transposed {
+            Axes {
+                x: (track.uy, sy, track.inv_uy),
+                y: (track.ux, sx, track.inv_ux),
+            }
+        } else {
+            Axes {
+                x: (track.ux, sx, track.inv_ux),
+                y: (track.uy, sy, track.inv_uy),
+            }
+        };
+        let lines = if track.tan_elevation < LOW_SUN {
+            LINES_LOW
+        } else {
+            LINES
+        };
+        let near = NearStencil::new(axes, rise, lines, hi as f64 - lo as f64);
         Frame {
             track,
             transposed,
@@ -148,6 +191,8 @@ impl<'a> Frame<'a> {
             rise,
             eps,
             max_height: hi,
+            near,
+            lines,
         }
     }
 
@@ -189,75 +234,81 @@ impl<'a> Frame<'a> {
         j1: i64,
         mask: &[AtomicU8],
     ) -> SweepStats {
-        let nb = (j1 - j0) as usize;
-        // Maxima over the rows beyond the current one (best1) and beyond the next (best2),
-        // the row of best2's maximum, and the last row's window values.
-        let mut best1 = vec![f64::NEG_INFINITY; nb];
-        let mut best2 = vec![f64::NEG_INFINITY; nb];
-        let mut row2 = vec![usize::MAX; nb];
-        let mut prev = vec![f64::NEG_INFINITY; nb];
-        let mut prev_row = usize::MAX;
-        let mut g = vec![0.0f64; self.w];
+        let q0 = j0.div_euclid(K);
+        let slots = (self.lines - 1) as usize;
+        let nq = (j1 - j0 + K - 1) as usize / K as usize;
+        let mut bands = Bands {
+            q0,
+            nq,
+            best2: vec![f64::NEG_INFINITY; K as usize * nq],
+            row2: vec![u32::MAX; K as usize * nq],
+            prev: vec![f64::NEG_INFINITY; slots * K as usize * nq],
+        };
+        let mut prev_row = vec![u32::MAX; slots];
+        // Scratch: the row's g = D − rise·x·u_x (padded), one window's maxima, the stencil.
+        let mut gp = vec![f64::NEG_INFINITY; nq + 8];
+        let mut wmax = vec![f64::NEG_INFINITY; nq];
+        let mut near = vec![0.0f32; nq + 2];
         let mut stats = SweepStats::default();
-        let max_height = self.max_height;
         let up = self.ucy > 0.0;
         let kx = self.rise * self.ucx;
         for step in 0..self.h {
             let y = if up { self.h - 1 - step } else { step };
-            self.decide_row(
-                map,
-                mip,
-                max_height,
-                y,
-                j0,
-                j1,
-                [&best1, &best2],
-                &row2,
-                mask,
-                &mut stats,
-            );
-            // The previous row is beyond the next row of the rows still to come.
-            if prev_row != usize::MAX {
-                for i in 0..nb {
-                    if prev[i] > best2[i] {
-                        best2[i] = prev[i];
-                        row2[i] = prev_row;
-                    }
-                }
-            }
+            // The ring slot of the row `lines − 1` steps back (it joins best2 now).
+            let slot = step % slots;
+            self.decide_row(map, mip, y, j0, j1, &bands, &mut near, mask, &mut stats);
+            // Rows beyond the next one of the rows still to come: the previous row joins.
             // This row's window values: for band j = K·q + s the maximum of g over
-            // q + lo[s] ..= q + hi[s], from a sliding maximum per window length.
+            // q + lo[s] ..= q + hi[s] (−∞ off the map).
             let row_term = self.rise * (y as f64 + 0.5) * self.ucy;
             let (lo, hi) = self.window(y);
-            let (q0, q1) = (j0.div_euclid(K), (j1 - 1).div_euclid(K));
-            let xa = (q0 + lo[0]).max(0);
-            let xb = (q1 + hi[K as usize - 1]).min(self.w as i64 - 1);
+            let omin = lo[0];
+            let len = nq + (hi[K as usize - 1] - omin) as usize;
+            if gp.len() < len {
+                gp.resize(len, f64::NEG_INFINITY);
+            }
+            let x_first = q0 + omin;
             let drow = &self.d[y * self.w..(y + 1) * self.w];
-            for x in xa.max(0) as usize..=(xb.max(-1) + 1) as usize {
-                if x < self.w {
-                    g[x] = drow[x] as f64 - kx * (x as f64 + 0.5);
+            // Columns x_first + t for t in ta..tb lie on the map.
+            let ta = (-x_first).clamp(0, len as i64) as usize;
+            let tb = (self.w as i64 - x_first).clamp(ta as i64, len as i64) as usize;
+            gp[..ta].fill(f64::NEG_INFINITY);
+            gp[tb..len].fill(f64::NEG_INFINITY);
+            if ta < tb {
+                let xa = (x_first + ta as i64) as usize;
+                for (t, (g, &dv)) in gp[ta..tb].iter_mut().zip(&drow[xa..]).enumerate() {
+                    *g = dv as f64 - kx * ((xa + t) as f64 + 0.5);
                 }
             }
-            for (s, (&l, &r)) in lo.iter().zip(&hi).enumerate() {
-                for q in q0..=q1 {
-                    let j = K * q + s as i64;
-                    if j < j0 || j >= j1 {
-                        continue;
-                    }
-                    let (a, b) = ((q + l).max(xa), (q + r).min(xb));
-                    let mut v = f64::NEG_INFINITY;
-                    for x in a..=b {
-                        v = v.max(g[x as usize]);
-                    }
-                    let v = v - row_term;
-                    let i = (j - j0) as usize;
-                    prev[i] = v;
-                    if v > best1[i] {
-                        best1[i] = v;
+            // Only bands ra..rb have a window on the map in this row.
+            let ra = (-hi[K as usize - 1] - q0).clamp(0, nq as i64) as usize;
+            let rb = (self.w as i64 - lo[0] - q0).clamp(ra as i64, nq as i64) as usize;
+            for s in 0..K as usize {
+                wmax.fill(f64::NEG_INFINITY);
+                for o in lo[s]..=hi[s] {
+                    let g = &gp[(o - omin) as usize + ra..][..rb - ra];
+                    for (m, &g) in wmax[ra..rb].iter_mut().zip(g) {
+                        *m = if g > *m { g } else { *m };
                     }
                 }
+                let r = s * nq..(s + 1) * nq;
+                let pr = (slot * K as usize + s) * nq..(slot * K as usize + s + 1) * nq;
+                let (best2, row2, prev) = (
+                    &mut bands.best2[r.clone()],
+                    &mut bands.row2[r],
+                    &mut bands.prev[pr],
+                );
+                let prev_row = prev_row[slot];
+                for i in 0..nq {
+                    let p = prev[i];
+                    if p > best2[i] {
+                        best2[i] = p;
+                        row2[i] = prev_row;
+                    }
+                    prev[i] = wmax[i] - row_term;
+                }
             }
-            prev_row = y;
+            prev_row[slot] = y as u32;
         }
         stats
     }
@@ -268,51 +319,73 @@ impl<'a> Frame<'a> {
         &self,
         map: &HeightMap,
         mip: Option<&MinMaxMipmap>,
-        max_height: f32,
         y: usize,
         j0: i64,
         j1: i64,
-        [best1, best2]: [&[f64]; 2],
-        row2: &[usize],
+        bands: &Bands,
+        near: &mut [f32],
         mask: &[AtomicU8],
         stats: &mut SweepStats,
     ) {
         let k = self.band_offset(y);
-        let x0 = (j0 - k).div_euclid(K) + ((j0 - k).rem_euclid(K) != 0) as i64;
-        let x1 = (j1 - 1 - k).div_euclid(K);
+        let x0 = ((j0 - k).div_euclid(K) + ((j0 - k).rem_euclid(K) != 0) as i64).max(0);
+        let x1 = (j1 - 1 - k).div_euclid(K).min(self.w as i64 - 1);
+        if x0 > x1 {
+            return;
+        }
+        // Pixel x's band is j = K·(x + kq) + s: entry s·nq + x + kq − q0.
+        let (kq, s) = (k.div_euclid(K), k.rem_euclid(K) as usize);
+        let band_base = s as i64 * bands.nq as i64 + kq - bands.q0;
+        // The stencil's pixels: xs..=xe.
+        let (mut xs, mut xe) = (1, 0);
+        if self.near.row_inside(y, self.h) {
+            let (a, b) = self.near.x_range(self.w);
+            (xs, xe) = (x0.max(a), x1.min(b));
+            if xs <= xe {
+                let n = (xe - xs + 1) as usize;
+                self.near
+                    .row_max(&self.z, self.w, y, xs as usize, &mut near[..n]);
+            }
+        }
         let zrow = &self.z[y * self.w..(y + 1) * self.w];
-        for x in x0.max(0)..=x1.min(self.w as i64 - 1) {
-            let i = (K * x + k - j0) as usize;
-            let zp = zrow[x as usize] as f64;
-            let pu = (x as f64 + 0.5) * self.ucx + (y as f64 + 0.5) * self.ucy;
+        let margin = self.near.margin;
+        let (rise, eps, ucx, ycy) = (self.rise, self.eps, self.ucx, (y as f64 + 0.5) * self.ucy);
+        for x in x0..=x1 {
+            let i = (band_base + x) as usize;
+            // The common case first: no texel of the first lines above the ray, bound below.
+            if xs <= x && x <= xe && near[(x - xs) as usize] < -margin {
+                let pu = (x as f64 + 0.5) * ucx + ycy;
+                if bands.best2[i] + rise * pu <= zrow[x as usize] as f64 - eps {
+                    stats.lit_by_bound += 1;
+                    continue;
+                }
+            }
             let (col, row) = if self.transposed {
                 (y, x as usize)
             } else {
                 (x as usize, y)
             };
-            let mut walk = Walk::new(map, self.track, col, row, self.transposed);
-            let shadowed = if walk.through_line() {
-                stats.shadowed_near += 1;
-                true
-            } else if best1[i] + self.rise * pu <= zp - self.eps {
-                stats.lit_by_bound += 1;
-                false
-            } else if walk.through_line() {
-                stats.shadowed_near += 1;
-                true
-            } else if best2[i] + self.rise * pu <= zp - self.eps {
-                stats.lit_by_bound += 1;
-                false
-            } else if row2[i] != usize::MAX
-                && witness(map, self.track, col, row, row2[i] as i64, self.transposed)
-            {
-                stats.shadowed_by_witness += 1;
-                true
+            let stencil = if xs <= x && x <= xe {
+                decide(near[(x - xs) as usize], margin)
             } else {
-                stats.traversed += 1;
-                match mip {
-                    Some(mip) => shadowed_accelerated(map, mip, self.track, col, row),
-                    None => shadowed_exact(map, self.track, col, row, max_height),
+                None
+            };
+            let shadowed = match stencil {
+                Some(true) => {
+                    stats.shadowed_near += 1;
+                    true
+                }
+                Some(false) => {
+                    self.far(map, mip, zrow[x as usize], x, y, col, row, bands, i, stats)
+                }
+                None => {
+                    let mut walk = Walk::new(map, self.track, col, row, self.transposed);
+                    if (0..self.lines).any(|_| walk.through_line()) {
+                        stats.shadowed_near += 1;
+                        true
+                    } else {
+                        self.far(map, mip, zrow[x as usize], x, y, col, row, bands, i, stats)
+                    }
                 }
             };
             if shadowed {
@@ -320,118 +393,52 @@ impl<'a> Frame<'a> {
             }
         }
     }
-}
 
-/// The exact traversal's walk ([`TrackWalk`]: [`shadowed_exact`]'s stepping), run one
-/// major-axis line at a time.
-struct Walk<'a> {
-    map: &'a HeightMap,
-    track: &'a Track,
-    walk: TrackWalk<'a>,
-    zp: f64,
-    transposed: bool,
-}
-
-impl<'a> Walk<'a> {
-    fn new(map: &'a HeightMap, track: &'a Track, col: usize, row: usize, transposed: bool) -> Self {
-        Walk {
-            map,
-            track,
-            walk: TrackWalk::new(map, track, col, row),
-            zp: map.heights[row * map.width + col] as f64,
-            transposed,
+    /// Decide a pixel whose own and next lines hold no texel above the ray: the bound over
+    /// the lines beyond, a witness in the line of the band's maximum, else the traversal.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn far(
+        &self,
+        map: &HeightMap,
+        mip: Option<&MinMaxMipmap>,
+        zp: f32,
+        x: i64,
+        y: usize,
+        col: usize,
+        row: usize,
+        bands: &Bands,
+        i: usize,
+        stats: &mut SweepStats,
+    ) -> bool {
+        let pu = (x as f64 + 0.5) * self.ucx + (y as f64 + 0.5) * self.ucy;
+        if bands.best2[i] + self.rise * pu <= zp as f64 - self.eps {
+            stats.lit_by_bound += 1;
+            return false;
         }
-    }
-
-    /// Test the texels of the current major-axis line; `true` when one is above the ray.
-    /// Afterwards the walk stands at the first texel of the next line (or has left the map).
-    fn through_line(&mut self) -> bool {
-        let major = |(x, y): (i64, i64)| if self.transposed { x } else { y };
-        let line = major(self.walk.current());
-        let p = self.walk.start();
-        while major(self.walk.current()) == line {
-            let Some(t) = self.walk.next() else {
-                break;
-            };
-            let (t_mid, hq) = texel_sample(self.map, self.track, p, [t.ix, t.iy], t.t_in, t.t_out);
-            if hq - self.zp > self.track.rise_per_t * t_mid {
-                return true;
-            }
-        }
-        false
-    }
-}
-
-/// Does a texel of (col, row)'s track in the original row `line` (or column, `transposed`)
-/// pass the exact test? Only texels the walking traversal visits are tested, with its exact
-/// transit times, so `true` means [`shadowed_exact`] is `true`.
-pub fn witness(
-    map: &HeightMap,
-    track: &Track,
-    col: usize,
-    row: usize,
-    line: i64,
-    transposed: bool,
-) -> bool {
-    let (px, py) = (col as f64 + 0.5, row as f64 + 0.5);
-    let zp = map.heights[row * map.width + col] as f64;
-    // Major axis (the one `line` indexes) and minor axis, as (p, step, inv_u, u, start, size).
-    let y_axis = (
-        py,
-        track.step_y,
-        track.inv_uy,
-        track.uy,
-        row as i64,
-        map.height as i64,
-    );
-    let x_axis = (
-        px,
-        track.step_x,
-        track.inv_ux,
-        track.ux,
-        col as i64,
-        map.width as i64,
-    );
-    let (major, minor) = if transposed {
-        (x_axis, y_axis)
-    } else {
-        (y_axis, x_axis)
-    };
-    let entry = |a: (f64, i64, f64, f64, i64, i64), c: i64| {
-        if c == a.4 {
-            0.0
-        } else {
-            Track::entry_time(a.0, c, a.1, a.2)
-        }
-    };
-    let exit = |a: (f64, i64, f64, f64, i64, i64), c: i64| Track::exit_time(a.0, c, a.1, a.2);
-    let (ta, tb) = (entry(major, line), exit(major, line));
-    if ta >= tb && line != major.4 {
-        return false;
-    }
-    let (from, to) = if minor.1 == 0 {
-        (minor.4, minor.4)
-    } else {
-        let (qa, qb) = (minor.0 + minor.3 * ta, minor.0 + minor.3 * tb);
-        (
-            (qa.min(qb).floor() as i64 - 1).max(0),
-            (qa.max(qb).floor() as i64 + 1).min(minor.5 - 1),
-        )
-    };
-    for c in from..=to {
-        let t_in = entry(minor, c).max(ta).max(0.0);
-        let t_out = exit(minor, c).min(tb);
-        let start = c == minor.4 && line == major.4;
-        if t_in >= t_out && !start {
-            continue;
-        }
-        let texel = if transposed { [line, c] } else { [c, line] };
-        let (t_mid, hq) = texel_sample(map, track, [px, py], texel, t_in, t_out);
-        if hq - zp > track.rise_per_t * t_mid {
+        let line = bands.row2[i];
+        if line != u32::MAX && witness(map, self.track, col, row, line as i64, self.transposed) {
+            stats.shadowed_by_witness += 1;
             return true;
         }
+        stats.traversed += 1;
+        let shadowed = match mip {
+            Some(mip) => shadowed_accelerated(map, mip, self.track, col, row),
+            None => shadowed_exact(map, self.track, col, row, self.max_height),
+        };
+        stats.traversed_shadowed += shadowed as u64;
+        shadowed
     }
-    false
+}
+
+/// The bands of one work item, entry s·nq + (q − q0) for band j = K·q + s: the maximum over
+/// the lines beyond the next one (best2), the line where it lies, the last line's values.
+struct Bands {
+    q0: i64,
+    nq: usize,
+    best2: Vec<f64>,
+    row2: Vec<u32>,
+    prev: Vec<f64>,
 }
 
 #[cfg(test)]

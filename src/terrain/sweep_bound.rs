@@ -6,9 +6,10 @@ use rayon::prelude::*;
 
 /// D(T): the maximum over T's square of F(q) = h(q) − rise·(q − c_T)·u at the nine points
 /// where it can lie (module docs), border-clamped like [`sample_bilinear`], for a w×h grid
-/// and the sun's rise per texel along x and y (`rise·u_x`, `rise·u_y`). Evaluated in f32 (it
-/// vectorises) and then raised by 2e-6 of the largest magnitude, which covers f32 rounding of
-/// the nine sums (about 8 ulps) with a margin of 30.
+/// and the sun's rise per texel along x and y (`rise·u_x`, `rise·u_y`); `peak` is at least
+/// every |height| ([`height_range`]). Evaluated in f32 (it vectorises) and then raised by 2e-6
+/// of the largest magnitude, which covers f32 rounding of the nine sums (about 8 ulps) with a
+/// margin of 30.
 ///
 /// [`sample_bilinear`]: super::exact_traversal::sample_bilinear
 pub fn directional_bound(
@@ -17,41 +18,63 @@ pub fn directional_bound(
     h: usize,
     rise_x: f64,
     rise_y: f64,
+    peak: f32,
 ) -> Vec<f32> {
-    let peak = heights.iter().fold(0.0f32, |m, v| m.max(v.abs()));
     let (ex, ey) = ((0.5 * rise_x) as f32, (0.5 * rise_y) as f32);
     let raise = 2e-6 * (peak + ex.abs() + ey.abs());
     let mut d = vec![0.0f32; w * h];
-    d.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
-        let (n, s) = (y.saturating_sub(1), (y + 1).min(h - 1));
-        // Rows padded by one clamped texel on each side, so the inner loop has no branches.
-        let pad = |r: usize| -> Vec<f32> {
-            let row = &heights[r * w..(r + 1) * w];
-            let mut v = Vec::with_capacity(w + 2);
-            v.push(row[0]);
-            v.extend_from_slice(row);
-            v.push(row[w - 1]);
-            v
-        };
-        let (rn, rc, rs) = (pad(n), pad(y), pad(s));
-        for (x, o) in out.iter_mut().enumerate() {
-            let (l, c, r) = (rc[x], rc[x + 1], rc[x + 2]);
-            let (nl, nc, nr) = (rn[x], rn[x + 1], rn[x + 2]);
-            let (sl, sc, sr) = (rs[x], rs[x + 1], rs[x + 2]);
-            // Offsets in texels: west (−½, 0), east, north (0, −½), south, and the corners.
-            let v = c
-                .max(0.5 * (c + l) + ex)
-                .max(0.5 * (c + r) - ex)
-                .max(0.5 * (c + nc) + ey)
-                .max(0.5 * (c + sc) - ey)
-                .max(0.25 * (c + l + nc + nl) + ex + ey)
-                .max(0.25 * (c + r + nc + nr) - ex + ey)
-                .max(0.25 * (c + l + sc + sl) + ex - ey)
-                .max(0.25 * (c + r + sc + sr) - ex - ey);
-            *o = v + raise;
-        }
-    });
+    let max = |a: f32, b: f32| if b > a { b } else { a };
+    d.par_chunks_mut(w).enumerate().for_each_init(
+        || {
+            [
+                vec![0.0f32; w + 2],
+                vec![0.0f32; w + 2],
+                vec![0.0f32; w + 2],
+            ]
+        },
+        |[rn, rc, rs], (y, out)| {
+            let (n, s) = (y.saturating_sub(1), (y + 1).min(h - 1));
+            // Rows padded by one clamped texel on each side, so the inner loop has no branches.
+            for (r, v) in [(n, &mut *rn), (y, &mut *rc), (s, &mut *rs)] {
+                let row = &heights[r * w..(r + 1) * w];
+                v[0] = row[0];
+                v[1..=w].copy_from_slice(row);
+                v[w + 1] = row[w - 1];
+            }
+            for (x, o) in out.iter_mut().enumerate() {
+                let (l, c, r) = (rc[x], rc[x + 1], rc[x + 2]);
+                let (nl, nc, nr) = (rn[x], rn[x + 1], rn[x + 2]);
+                let (sl, sc, sr) = (rs[x], rs[x + 1], rs[x + 2]);
+                // Offsets in texels: west (−½, 0), east, north (0, −½), south, and the corners.
+                let mut v = max(c, 0.5 * (c + l) + ex);
+                v = max(v, 0.5 * (c + r) - ex);
+                v = max(v, 0.5 * (c + nc) + ey);
+                v = max(v, 0.5 * (c + sc) - ey);
+                v = max(v, 0.25 * (c + l + nc + nl) + ex + ey);
+                v = max(v, 0.25 * (c + r + nc + nr) - ex + ey);
+                v = max(v, 0.25 * (c + l + sc + sl) + ex - ey);
+                v = max(v, 0.25 * (c + r + sc + sr) - ex - ey);
+                *o = v + raise;
+            }
+        },
+    );
     d
+}
+
+/// The smallest and largest height (one parallel pass; the heights must not be NaN).
+pub fn height_range(heights: &[f32]) -> (f32, f32) {
+    heights
+        .par_chunks(1 << 16)
+        .map(|c| {
+            c.iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                    (if v < lo { v } else { lo }, if v > hi { v } else { hi })
+                })
+        })
+        .reduce(
+            || (f32::INFINITY, f32::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        )
 }
 
 /// Transpose a w×h row-major grid (blocked for the cache).
@@ -95,6 +118,7 @@ mod tests {
                 h,
                 track.rise_per_t * track.ux,
                 track.rise_per_t * track.uy,
+                7.5 * 1.5,
             );
             for y in 0..h {
                 for x in 0..w {
