@@ -81,3 +81,37 @@ pub fn random_map(w: usize, h: usize, seed: u64, cell: [f64; 2], scale: f32) -> 
     }
     HeightMap::new(w, h, heights, cell)
 }
+
+/// Proptest strategies for suns and cells at the numerical extremes: azimuths on the axes and
+/// diagonals, 1e-12 and 1e-10 off an axis; elevations near the horizon and the zenith
+/// (`with_ends`: exactly 0° and 90° too); square and anisotropic cells.
+pub mod strategies {
+    use proptest::prelude::*;
+
+    pub fn azimuth() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            prop::sample::select(vec![0.0, 90.0, 180.0, 270.0, 45.0, 135.0, 225.0, 315.0]),
+            prop::sample::select(vec![0.0, 90.0, 180.0, 270.0]).prop_map(|a| a + 1e-12),
+            prop::sample::select(vec![0.0, 90.0, 180.0, 270.0]).prop_map(|a| a - 1e-10),
+            0.0..360.0f64,
+        ]
+    }
+
+    pub fn elevation(with_ends: bool) -> impl Strategy<Value = f64> {
+        let mut fixed = vec![1e-9, 1e-3, 0.5, 89.999, 89.999_999, 45.0];
+        if with_ends {
+            fixed.extend([0.0, 90.0]);
+        }
+        prop_oneof![prop::sample::select(fixed), 0.01..89.9f64]
+    }
+
+    pub fn cell() -> impl Strategy<Value = [f64; 2]> {
+        prop::sample::select(vec![
+            [1.0, 1.0],
+            [30.0, 30.0],
+            [1.0, 2.5],
+            [0.7, 0.2],
+            [40.0, 40.0],
+        ])
+    }
+}
