@@ -77,10 +77,15 @@ fn read_image(path: &Path) -> Result<RawGrid> {
             ));
         }
     }
-    let img = reader.decode().map_err(|e| match e {
-        image::ImageError::IoError(io) => Error::io(path, "cannot read height map", io),
-        other => Error::input(path, format!("cannot decode {format}: {other}")),
-    })?;
+    // zune-jpeg 0.5 multiplies a DC prediction by its quantiser unchecked: a malformed scan
+    // overflows (a panic where overflow checks are on; found by AFL), so the decoder runs
+    // contained and any panic becomes an input error.
+    let img = crate::error::contain_panic(path, "image decoder", || reader.decode())?.map_err(
+        |e| match e {
+            image::ImageError::IoError(io) => Error::io(path, "cannot read height map", io),
+            other => Error::input(path, format!("cannot decode {format}: {other}")),
+        },
+    )?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     let (values, sample): (Vec<f64>, &'static str) = match &img {
         D::ImageLuma8(b) => (b.as_raw().iter().map(|&v| v as f64).collect(), "u8"),
