@@ -85,13 +85,19 @@ struct SunLight {
     mu_s: f32,
 }
 
+// Cosine of the horizon's zenith angle seen from radius r: 0 on the ground, negative above
+// (twin: twin::horizon_cosine).
+fn horizon_cosine(r: f32) -> f32 {
+    let q = atmo.radii.x / max(r, atmo.radii.x);
+    return -sqrt(max(1.0 - q * q, 0.0));
+}
+
 fn sun_light(x: vec3<f32>, sun: vec3<f32>) -> SunLight {
     let r = length(x);
     let mu_s = dot(x, sun) / r;
     // Below the local horizon the planet hides the sun (twin: lut::sun_light).
-    let q = atmo.radii.x / max(r, atmo.radii.x);
     var shadow = 1.0;
-    if (mu_s < -sqrt(max(1.0 - q * q, 0.0))) {
+    if (mu_s < horizon_cosine(r)) {
         shadow = 0.0;
     }
     return SunLight(shadow, atmo_transmittance(r, mu_s), mu_s);
@@ -130,9 +136,7 @@ fn build_multi_scattering(@builtin(global_invocation_id) id: vec3<u32>) {
     let o = vec3<f32>(0.0, r, 0.0);
     let sun = vec3<f32>(sqrt(max(1.0 - mu_s * mu_s, 0.0)), mu_s, 0.0);
     let iso = 1.0 / (4.0 * PI);
-    // Cosine of the horizon's zenith angle (twin: horizon_cosine).
-    let q = atmo.radii.x / max(r, atmo.radii.x);
-    let mu_h = -sqrt(max(1.0 - q * q, 0.0));
+    let mu_h = horizon_cosine(r);
     let half = MULTI_BANDS / 2u;
     var l2 = vec3<f32>(0.0);
     var fms = vec3<f32>(0.0);
