@@ -28,7 +28,8 @@ pub fn check_declared_samples(
 }
 
 /// Read an OpenEXR file's headers and refuse one whose parts together declare more than
-/// [`MAX_IMAGE_SAMPLES`], before the `exr` crate allocates them. Returns the number of parts
+/// [`MAX_IMAGE_SAMPLES`], or that is too short to hold the chunks they declare, before the `exr`
+/// crate allocates them. Returns the number of parts
 /// (0 when the header is unreadable: the decoder then reports it).
 pub fn check_exr_header(path: &std::path::Path) -> Result<usize> {
     let Ok(meta) = exr::meta::MetaData::read_from_file(path, false) else {
@@ -50,6 +51,22 @@ pub fn check_exr_header(path: &std::path::Path) -> Result<usize> {
                 last.0,
                 last.1,
                 last.2
+            ),
+        ));
+    }
+    // Every chunk the headers declare has an 8-byte offset-table entry and, in the file, at least
+    // its 8-byte chunk header (scan line y or tile coordinates, and data size): a file shorter
+    // than that cannot hold the image, and the decoder would fill what is missing (a 400-byte
+    // "decompression bomb" took it seconds and gigabytes; found by AFL).
+    let chunks: u64 = meta.headers.iter().map(|h| h.chunk_count as u64).sum();
+    let need = chunks.saturating_mul(16);
+    let have = std::fs::metadata(path).map_or(u64::MAX, |m| m.len());
+    if have < need {
+        return Err(Error::input(
+            path,
+            format!(
+                "the header declares {chunks} chunk(s), which need at least {need} bytes, but \
+                 the file has {have}: truncated or damaged"
             ),
         ));
     }

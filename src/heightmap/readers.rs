@@ -66,6 +66,9 @@ fn read_image(path: &Path) -> Result<RawGrid> {
     // The header alone, before the decoder allocates (and walks) what it declares.
     if let Ok((w, h)) = open()?.into_dimensions() {
         crate::limits::check_declared_samples(path, w as u64, h as u64, 1)?;
+        if format == "jpeg" {
+            check_jpeg_size(path, &bytes, w as u64, h as u64)?;
+        }
         if format == "jpeg" && w.max(h) > 65528 {
             // zune-jpeg 0.5 computes `(side + 7) / 8` in u16: it wraps and decodes zeros (an
             // overflow panic under the fuzzers' overflow checks).
@@ -135,6 +138,71 @@ fn check_jpeg_complete(path: &Path, bytes: &[u8]) -> Result<()> {
             ),
         ))
     }
+}
+
+/// A JPEG whose declared size its file cannot hold (a decompression bomb: the fuzzer's 343-byte
+/// files declaring 100–390 M texels took the decoder 2–14 s and gigabytes, filling the missing
+/// scan data with zeros). In a Huffman-coded JPEG (baseline, extended, progressive or lossless:
+/// SOF0–3, 5–7) every 8×8 block of every component has its DC coefficient coded, at least one
+/// bit (a Huffman code is 1–16 bits long), so the file holds at least one bit per block of the
+/// component with the fewest blocks. Arithmetic-coded files (which the decoder refuses anyway)
+/// and files without a frame header are left to the decoder.
+fn check_jpeg_size(path: &Path, bytes: &[u8], w: u64, h: u64) -> Result<()> {
+    let Some(frame) = jpeg_frame_header(bytes) else {
+        return Ok(());
+    };
+    let factors: Vec<(u64, u64)> = frame
+        .get(8..)
+        .unwrap_or(&[])
+        .chunks_exact(3)
+        .take(frame.get(7).copied().unwrap_or(0) as usize)
+        .map(|c| ((c[1] >> 4) as u64, (c[1] & 15) as u64))
+        .filter(|&(hf, vf)| hf > 0 && vf > 0)
+        .collect();
+    let hmax = factors.iter().map(|f| f.0).max().unwrap_or(1);
+    let vmax = factors.iter().map(|f| f.1).max().unwrap_or(1);
+    let blocks = factors
+        .iter()
+        .map(|&(hf, vf)| (w * hf).div_ceil(hmax).div_ceil(8) * (h * vf).div_ceil(vmax).div_ceil(8))
+        .min()
+        .unwrap_or(0);
+    let need = blocks.div_ceil(8);
+    if (bytes.len() as u64) < need {
+        return Err(Error::input(
+            path,
+            format!(
+                "a {w}x{h} JPEG cannot be coded in {} bytes: its {blocks} blocks of 8x8 texels need at least {need} (one bit each); the file is damaged or a decompression bomb",
+                bytes.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The segment of a Huffman-coded JPEG's frame header (SOF0–3, 5–7) after its marker: length (2
+/// bytes), precision (1), height (2), width (2), component count (1), then (id, sampling
+/// factors, table) per component from byte 8.
+fn jpeg_frame_header(bytes: &[u8]) -> Option<&[u8]> {
+    let mut i = 2; // after SOI
+    while i + 4 <= bytes.len() {
+        if bytes[i] != 0xFF {
+            i += 1; // junk between segments: decoders skip to the next marker, so do we
+            continue;
+        }
+        let marker = bytes[i + 1];
+        if marker == 0xFF {
+            i += 1; // fill byte
+            continue;
+        }
+        let len = u16::from_be_bytes([bytes[i + 2], bytes[i + 3]]) as usize;
+        let body = bytes.get(i + 2..i + 2 + len)?;
+        match marker {
+            0xC0..=0xC3 | 0xC5..=0xC7 => return Some(body),
+            0xC9..=0xCB | 0xCD..=0xCF | 0xDA | 0xD9 => return None,
+            _ => i += 2 + len,
+        }
+    }
+    None
 }
 
 /// Take one channel of an RGB image whose channels are all equal; refuse real colour images.

@@ -39,3 +39,14 @@ open("not-an-exr.exr", "wb").write(b"v/1\x01" + b"\x00" * 60)
 import random
 random.seed(7)
 open("binary.ron", "wb").write(bytes(random.randrange(256) for _ in range(200)))
+# An EXR whose header declares 4096x4096 ZIP texels (256 chunks) but whose file ends after 1000
+# bytes: refused before the decoder allocates and fills what is missing.
+import OpenEXR, Imath
+_h = OpenEXR.Header(4096, 4096)
+_h["channels"] = {"Y": Imath.Channel(Imath.PixelType(Imath.PixelType.FLOAT))}
+_h["compression"] = Imath.Compression(Imath.Compression.ZIP_COMPRESSION)
+_f = OpenEXR.OutputFile("exr-chunks-missing.exr", _h)
+_f.writePixels({"Y": np.zeros((4096, 4096), np.float32).tobytes()})
+_f.close()
+_b = open("exr-chunks-missing.exr", "rb").read()[:1000]
+open("exr-chunks-missing.exr", "wb").write(_b)
