@@ -70,7 +70,56 @@ pub fn check_exr_header(path: &std::path::Path) -> Result<usize> {
             ),
         ));
     }
+    // What the pixels decode to against what the file could hold at its compression's largest
+    // expansion ([`exr_max_expansion`]): a 530-byte DWAB file declaring 134–805 M samples
+    // decoded (into zeros) for 2–22 s and 1.5–10 GB (found by AFL).
+    for h in meta.headers.iter() {
+        let per_texel: u64 = h
+            .channels
+            .list
+            .iter()
+            .map(|c| c.sample_type.bytes_per_sample() as u64)
+            .sum();
+        let raw = (h.layer_size.width() as u64)
+            .saturating_mul(h.layer_size.height() as u64)
+            .saturating_mul(per_texel);
+        let ratio = exr_max_expansion(h.compression);
+        if raw > have.saturating_mul(ratio) {
+            return Err(Error::input(
+                path,
+                format!(
+                    "the header declares {}x{} texels ({raw} bytes of samples) with {}, which \
+                     expands at most {ratio}:1, but the file has {have} bytes: damaged, or a \
+                     decompression bomb",
+                    h.layer_size.width(),
+                    h.layer_size.height(),
+                    h.compression
+                ),
+            ));
+        }
+    }
     Ok(meta.headers.len())
+}
+
+/// The largest ratio of decoded sample bytes to stored bytes an OpenEXR compression can reach,
+/// with margin. None: 1. RLE: a 2-byte run codes at most 128 bytes (64:1). ZIP, ZIPS: deflate's
+/// limit, 1032:1; PXR24 deflates 3 of every 4 bytes of a float (1376:1). B44/B44A: a 4x4 block
+/// of halves (32 bytes) in at least 3 bytes, floats stored as they are (11:1). PIZ: Huffman codes
+/// of at least 1 bit with run-length codes of at most 255 repeats in at least 10 bits (~410:1
+/// for 16-bit values): 4096 leaves a tenfold margin. DWAA/DWAB and HTJ2K code a flat 8x8 block
+/// in a DC value deflated at most 1032:1 (2 bytes for 64 samples of up to 4 bytes: ~132,000:1):
+/// 2^18. A file over these bounds cannot hold the samples its header declares.
+fn exr_max_expansion(c: exr::compression::Compression) -> u64 {
+    use exr::compression::Compression as C;
+    match c {
+        C::Uncompressed => 1,
+        C::RLE => 64,
+        C::ZIP1 | C::ZIP16 => 1032,
+        C::PXR24 => 1376,
+        C::B44 | C::B44A => 11,
+        C::PIZ => 4096,
+        C::DWAA(_) | C::DWAB(_) | C::HTJ2K32 | C::HTJ2K256 => 1 << 18,
+    }
 }
 
 /// Physical memory of this machine in bytes (Linux `/proc/meminfo`; 8 GiB when unknown).
