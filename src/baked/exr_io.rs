@@ -58,13 +58,20 @@ pub fn read_f32_channels(path: &Path) -> Result<(usize, usize, Channels)> {
             format!("a multi-part EXR ({parts} parts) where relume writes a single part"),
         ));
     }
-    let image = read()
+    let reader = read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
+        .all_attributes();
+    // exr 1.74's B44 decoder relies on wrapping u32 arithmetic (as OpenEXR's C code does with
+    // unsigned ints): release builds wrap and decode in parallel; with overflow checks (debug
+    // builds, and the fuzzers' builds) it panics — in a worker thread, where the panic aborts the
+    // process (found by AFL). So debug builds decode on this thread, and the decode is contained
+    // either way: a panic is an input error naming the file.
+    #[cfg(debug_assertions)]
+    let reader = reader.non_parallel();
+    let image = crate::error::contain_panic(path, "EXR decoder", || reader.from_file(path))?
         .map_err(|e| exr_error(path, "cannot read EXR", e))?;
     let layer = image.layer_data;
     let channels = layer

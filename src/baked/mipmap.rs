@@ -68,13 +68,16 @@ pub fn read_file(path: &Path) -> Result<MinMaxMipmap> {
     use exr::meta::attribute::AttributeValue;
     use exr::prelude::*;
     crate::limits::check_exr_header(path)?;
-    let image = read()
+    let reader = read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .all_layers()
-        .all_attributes()
-        .from_file(path)
+        .all_attributes();
+    // Debug builds decode on this thread, contained (exr_io::read_f32_channels).
+    #[cfg(debug_assertions)]
+    let reader = reader.non_parallel();
+    let image = crate::error::contain_panic(path, "EXR decoder", || reader.from_file(path))?
         .map_err(|e| exr_io::exr_error(path, "cannot read EXR", e))?;
     let bad = |m: String| crate::error::Error::input(path, m);
     let first = image.layer_data.first().map(|l| &l.attributes.other);

@@ -241,13 +241,16 @@ fn read_exr(path: &Path) -> Result<RawGrid> {
             format!("a multi-part EXR ({parts} parts): a height map is a single-part file"),
         ));
     }
-    let image = read()
+    let reader = read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
+        .all_attributes();
+    // Debug builds decode on this thread, contained (crate::baked::exr_io::read_f32_channels).
+    #[cfg(debug_assertions)]
+    let reader = reader.non_parallel();
+    let image = crate::error::contain_panic(path, "EXR decoder", || reader.from_file(path))?
         .map_err(|e| match e {
             exr::error::Error::Io(io) => Error::io(path, "cannot read height map", io),
             other => Error::input(path, format!("cannot decode EXR: {other}")),
