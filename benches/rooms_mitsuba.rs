@@ -12,18 +12,22 @@
 //! 4.4 % of its area hidden above the light, which relume cuts away).
 //!
 //! Run: `cargo bench --bench rooms_mitsuba` (`PATCHES=1000,2000,4000,8000`,
-//! `SCENE=door-ajar|cornell`).
+//! `SCENE=door-ajar|cornell`, `ADAPTIVE=1` for `Resolution::Adaptive` instead of
+//! `TargetPatches`).
 
 #[path = "../tests/support/room_light.rs"]
 mod room_light;
 mod util;
 
+use relume::radiosity::adaptive::AdaptiveParams;
+use relume::radiosity::voxelize::Resolution;
 use std::time::Instant;
 
 fn main() {
     let root = env!("CARGO_MANIFEST_DIR");
     let name: String = util::env("SCENE", "door-ajar".to_string());
     let targets: Vec<u32> = util::env_list("PATCHES", "1000,2000,4000,8000");
+    let adaptive = util::env("ADAPTIVE", 0u32) == 1;
     let scene = room_light::room(&name);
     let reference: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(format!("{root}/tests/reference/{name}.mitsuba.json")).unwrap(),
@@ -32,8 +36,9 @@ fn main() {
     let objects: Vec<&String> = reference.as_object().unwrap().keys().collect();
     println!(
         "{name}: {} triangles; relume per-object irradiance (patches | corner-interpolated) vs \
-         Mitsuba, relative error, mean over RGB; {} threads\n",
+         Mitsuba, relative error, mean over RGB; {} patches; {} threads\n",
         scene.triangles.len(),
+        if adaptive { "adaptive" } else { "uniform" },
         rayon::current_num_threads()
     );
     print!("| object | Mitsuba (rel. std. error) |");
@@ -55,7 +60,12 @@ fn main() {
     let mut summary = Vec::new();
     for &target in &targets {
         let t0 = Instant::now();
-        let (light, patches) = room_light::object_light_at(&scene, target);
+        let resolution = if adaptive {
+            Resolution::Adaptive(AdaptiveParams::new(target))
+        } else {
+            Resolution::TargetPatches(target)
+        };
+        let (light, patches) = room_light::object_light_with(&scene, resolution);
         let seconds = t0.elapsed().as_secs_f64();
         let mut worst = (0f64, 0f64);
         for (row, o) in rows.iter_mut().zip(&objects) {

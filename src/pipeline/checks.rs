@@ -93,7 +93,8 @@ pub fn cell_size(v: (f64, f64)) -> Result<(f64, f64), String> {
     }
 }
 
-/// `VoxelSize(s)` with s positive and finite, or `TargetPatches(n)` with n ≥ 1.
+/// `VoxelSize(s)` with s positive and finite, `TargetPatches(n)` with n ≥ 1, or `Adaptive(..)`
+/// with the ranges of [`crate::radiosity::adaptive::AdaptiveParams::check`].
 pub fn resolution(v: Resolution) -> Result<Resolution, String> {
     match v {
         Resolution::VoxelSize(s) if !(s.is_finite() && s > 0.0) => Err(format!(
@@ -102,6 +103,7 @@ pub fn resolution(v: Resolution) -> Result<Resolution, String> {
         Resolution::TargetPatches(0) => {
             Err("out of range: TargetPatches(0) (must be at least 1)".into())
         }
+        Resolution::Adaptive(a) => a.check().map(|()| v),
         v => Ok(v),
     }
 }

@@ -76,28 +76,42 @@ pub(super) fn clip_pieces(
     pieces
 }
 
-/// Split each group of `pieces` (sorted by key) into clusters that see each other: a piece joins
-/// the first cluster whose representative (its first piece's lifted centroid) it sees. One
-/// cluster is one patch.
+/// Split each group of `pieces` (sorted by key) into clusters that see each other
+/// ([`split_visible`]). One cluster is one patch.
 pub(super) fn clusters(pieces: &[(u64, Piece)], vis: &Visibility) -> Vec<(u64, Vec<usize>)> {
-    let lift = 4.0 * vis.epsilon as f64;
     let mut out = Vec::new();
     let mut start = 0;
     while start < pieces.len() {
         let key = pieces[start].0;
         let end = start + pieces[start..].iter().take_while(|p| p.0 == key).count();
-        let mut group: Vec<(DVec3, Vec<usize>)> = Vec::new();
-        for (i, (_, p)) in pieces.iter().enumerate().take(end).skip(start) {
-            let c = lifted_centroid(p, lift);
-            match group.iter_mut().find(|(rep, _)| !vis.occluded(c, *rep)) {
-                Some((_, members)) => members.push(i),
-                None => group.push((c, vec![i])),
-            }
-        }
-        out.extend(group.into_iter().map(|(_, m)| (key, m)));
+        let members: Vec<usize> = (start..end).collect();
+        out.extend(
+            split_visible(&members, pieces, vis)
+                .into_iter()
+                .map(|m| (key, m)),
+        );
         start = end;
     }
     out
+}
+
+/// Split `members` (indices into `pieces`) into clusters that see each other: a piece joins
+/// the first cluster whose representative (its first piece's lifted centroid) it sees.
+pub(super) fn split_visible(
+    members: &[usize],
+    pieces: &[(u64, Piece)],
+    vis: &Visibility,
+) -> Vec<Vec<usize>> {
+    let lift = 4.0 * vis.epsilon as f64;
+    let mut group: Vec<(DVec3, Vec<usize>)> = Vec::new();
+    for &i in members {
+        let c = lifted_centroid(&pieces[i].1, lift);
+        match group.iter_mut().find(|(rep, _)| !vis.occluded(c, *rep)) {
+            Some((_, m)) => m.push(i),
+            None => group.push((c, vec![i])),
+        }
+    }
+    group.into_iter().map(|(_, m)| m).collect()
 }
 
 fn lifted_centroid(p: &Piece, lift: f64) -> DVec3 {

@@ -14,6 +14,7 @@
 //! docs/baked-format.md describes
 //! them byte by byte.
 
+pub mod adaptive;
 pub mod clip;
 pub mod corners;
 pub mod display;

@@ -17,15 +17,19 @@
 //! The voxel size is a knob, or it is chosen by bisection so that the number of (voxel, axis)
 //! groups is closest to a target patch count.
 
+use super::adaptive::{self, AdaptiveParams, Cell};
 use super::clip::{clip_pieces, clusters, grid_dims, SNAP};
+use super::formfactor::{form_factors, Estimator, FormFactorParams};
 use super::geometry::{self, axis_vector, split_key, Frame};
 use super::overlap::{self, Face};
 use super::visibility::Visibility;
 use super::voxel_size::SizeSearch;
 use super::{Patch, PatchLists, PatchSet, Piece, SurfacePoint, VoxelizeStats};
 use crate::error::{Error, Result};
+use crate::progress::Silent;
 use crate::scene::Scene;
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// How fine the voxel grid is.
@@ -35,6 +39,9 @@ pub enum Resolution {
     VoxelSize(f64),
     /// Choose the voxel size so that about this many patches result.
     TargetPatches(u32),
+    /// About `target` patches, refined where materials, geometry or light vary
+    /// ([`super::adaptive`]).
+    Adaptive(AdaptiveParams),
 }
 
 /// Knobs of [`voxelize`].
@@ -96,38 +103,59 @@ pub fn voxelize_noting(
         .collect();
     let visible = overlap::visible_parts(&faces, tolerance);
 
-    let mut note = None;
-    let size = match params.resolution {
-        Resolution::VoxelSize(s) => s,
-        Resolution::TargetPatches(n) => {
-            let search = SizeSearch {
-                scene,
-                live: &live,
-                faces: &faces,
-                polys: &visible.polygons,
-                origin: lo,
-                extent,
-            };
-            let choice = search.for_target(n);
-            note = choice.note;
-            choice.size
-        }
-    };
-    let Some(dims) = grid_dims(extent, size) else {
-        let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
-        return Err(Error::knob(format!(
-            "voxel size {size} gives a grid of {:.0} x {:.0} x {:.0} voxels for a scene of extent {:?}; use a larger voxel size or a smaller target patch count",
-            dims_f.x, dims_f.y, dims_f.z, extent.to_array()
-        )));
-    };
-    let frame = Frame {
+    let search = SizeSearch {
+        scene,
+        live: &live,
+        faces: &faces,
+        polys: &visible.polygons,
         origin: lo,
-        scale: size,
+        extent,
+    };
+    let grid = |size: f64| {
+        let Some(dims) = grid_dims(extent, size) else {
+            let dims_f = (extent / size - DVec3::splat(SNAP)).ceil().max(DVec3::ONE);
+            return Err(Error::knob(format!(
+                "voxel size {size} gives a grid of {:.0} x {:.0} x {:.0} voxels for a scene of extent {:?}; use a larger voxel size or a smaller target patch count",
+                dims_f.x, dims_f.y, dims_f.z, extent.to_array()
+            )));
+        };
+        let frame = Frame {
+            origin: lo,
+            scale: size,
+        };
+        let pieces = clip_pieces(&live, &faces, &visible.polygons, size, dims);
+        let extent_grid = dims.iter().copied().max().unwrap_or(1) as f64;
+        let vis = Visibility::new(scene, &live, &frame, extent_grid);
+        Ok((dims, frame, pieces, vis))
     };
 
-    let pieces = clip_pieces(&live, &faces, &visible.polygons, size, dims);
-    let extent_grid = dims.iter().copied().max().unwrap_or(1) as f64;
-    let vis = Visibility::new(scene, &live, &frame, extent_grid);
+    let mut note = None;
+    let (dims, frame, pieces, vis, groups) = match params.resolution {
+        Resolution::VoxelSize(size) => {
+            let (dims, frame, pieces, vis) = grid(size)?;
+            let groups = clusters(&pieces, &vis);
+            (dims, frame, pieces, vis, groups)
+        }
+        Resolution::TargetPatches(n) => {
+            let choice = search.for_target(n);
+            note = choice.note;
+            let (dims, frame, pieces, vis) = grid(choice.size)?;
+            let groups = clusters(&pieces, &vis);
+            (dims, frame, pieces, vis, groups)
+        }
+        Resolution::Adaptive(a) => {
+            let (dims, frame, mut pieces, vis, cells) = adaptive_base(&search, &grid, scene, &a)?;
+            let materials = cells.len();
+            let (cells, report) =
+                adaptive::refine(&mut pieces, cells, dims, &vis, &a, |cells, pieces| {
+                    coarse_light(scene, &frame, dims, cells, pieces)
+                });
+            note = adaptive_note(&a, cells.len(), materials, &report);
+            let groups = cells.into_iter().map(|c| (c.key, c.members)).collect();
+            (dims, frame, pieces, vis, groups)
+        }
+    };
+    let size = frame.scale;
 
     // One patch per cluster of mutually visible pieces of a (voxel, axis) group.
     let mut set = PatchSet {
@@ -136,10 +164,11 @@ pub fn voxelize_noting(
         dims,
         ..Default::default()
     };
-    for (key, members) in clusters(&pieces, &vis) {
+    for (key, members) in groups {
         let patch = build_patch(scene, &frame, key, dims, &members, &pieces, &mut set);
         set.patches.push(patch);
     }
+    drop(pieces);
 
     // Direct-light sample points and the triangle → patch map.
     set.samples_per_patch = params.samples_per_patch;
@@ -173,6 +202,111 @@ pub fn voxelize_noting(
 }
 
 pub use super::clip::clip_to_voxels;
+
+/// A grid: its dimensions and frame, the pieces clipped into it, the visibility BVH over it.
+type Grid = ([u32; 3], Frame, Vec<(u64, Piece)>, Visibility);
+
+/// The base grid of `Adaptive`, split by material: sized for `base_share · target` patches,
+/// and made coarser (up to twice more) while the material split alone exceeds the target.
+fn adaptive_base(
+    search: &SizeSearch,
+    grid: &dyn Fn(f64) -> Result<Grid>,
+    scene: &Scene,
+    a: &AdaptiveParams,
+) -> Result<([u32; 3], Frame, Vec<(u64, Piece)>, Visibility, Vec<Cell>)> {
+    let mut base = (a.target as f64 * a.base_share).max(1.0);
+    for attempt in 1.. {
+        let choice = search.for_target(base.round().max(1.0) as u32);
+        let (dims, frame, pieces, vis) = grid(choice.size)?;
+        let groups = clusters(&pieces, &vis);
+        let (cells, _) = adaptive::by_material(scene, groups, &pieces, dims, a.albedo_tolerance);
+        if cells.len() <= a.target as usize || attempt == 3 {
+            return Ok((dims, frame, pieces, vis, cells));
+        }
+        base *= 0.8 * a.target as f64 / cells.len() as f64;
+    }
+    unreachable!()
+}
+
+/// Why `Adaptive` missed its target by more than 20 %, if it did.
+fn adaptive_note(
+    a: &AdaptiveParams,
+    patches: usize,
+    materials: usize,
+    report: &adaptive::Refinement,
+) -> Option<String> {
+    let n = a.target as f64;
+    if (patches as f64 - n).abs() <= 0.2 * n {
+        return None;
+    }
+    Some(if materials as f64 > 1.2 * n {
+        format!(
+            "separating materials (albedo_tolerance {}) alone makes {materials} patches on the coarsest base grid tried; raise the target or the tolerance",
+            a.albedo_tolerance
+        )
+    } else {
+        format!(
+            "every cell that could be split was split {} time(s) (max_level) after {} geometry and {} light splits; raise max_level or base_share",
+            a.max_level, report.geometry_splits, report.light_splits
+        )
+    })
+}
+
+/// Rays per patch of the coarse bake that guides light refinement.
+pub const COARSE_RAYS: u32 = 1024;
+
+/// The coarse bake of `Adaptive`: each cell's gathered light H_i = Σ_j F_ij B_j (mean over the
+/// colour channels) from the scene's emitters, by reciprocal hemisphere form factors
+/// ([`COARSE_RAYS`] rays per cell) and Gauss–Seidel; `None` when the scene has no emitter.
+fn coarse_light(
+    scene: &Scene,
+    frame: &Frame,
+    dims: [u32; 3],
+    cells: &[Cell],
+    pieces: &[(u64, Piece)],
+) -> Option<Vec<f64>> {
+    if !scene.materials.iter().any(|m| m.is_emissive()) {
+        return None;
+    }
+    let mut set = PatchSet {
+        voxel_size: frame.scale,
+        origin: frame.origin.to_array(),
+        dims,
+        ..Default::default()
+    };
+    for c in cells {
+        let patch = build_patch(scene, frame, c.key, dims, &c.members, pieces, &mut set);
+        set.patches.push(patch);
+    }
+    let params = FormFactorParams {
+        estimator: Estimator::HemisphereReciprocal,
+        samples: COARSE_RAYS,
+        seed: 0,
+    };
+    let f = form_factors(scene, &set, &params, &Silent).ok()?;
+    let n = f.n;
+    let mut h = vec![0.0; n];
+    for c in 0..3 {
+        let rho: Vec<f64> = set.patches.iter().map(|p| p.albedo[c] as f64).collect();
+        let e: Vec<f64> = set
+            .patches
+            .iter()
+            .map(|p| std::f64::consts::PI * p.emission[c] as f64)
+            .collect();
+        let b = super::reference::gauss_seidel(&f.values, &rho, &e, 1e-4, 1000)
+            .ok()?
+            .b;
+        let gathered: Vec<f64> = f
+            .values
+            .par_chunks(n)
+            .map(|row| row.iter().zip(&b).map(|(&fij, bj)| fij as f64 * bj).sum())
+            .collect();
+        for (h, g) in h.iter_mut().zip(gathered) {
+            *h += g / 3.0;
+        }
+    }
+    Some(h)
+}
 
 fn build_patch(
     scene: &Scene,

@@ -25,10 +25,15 @@ pub fn room(name: &str) -> Scene {
 
 /// Per-object light of `scene` lit by its emitters, and the patch count.
 pub fn object_light_at(scene: &Scene, target: u32) -> (Vec<ObjectLight>, usize) {
+    object_light_with(scene, Resolution::TargetPatches(target))
+}
+
+/// [`object_light_at`] with any voxel resolution (e.g. adaptive patches).
+pub fn object_light_with(scene: &Scene, resolution: Resolution) -> (Vec<ObjectLight>, usize) {
     let set = voxelize(
         scene,
         &VoxelizeParams {
-            resolution: Resolution::TargetPatches(target),
+            resolution,
             samples_per_patch: 1,
         },
     )

@@ -26,9 +26,14 @@ impl StageRun for VoxelizeKnobs {
         progress.begin("voxelize", 0);
         let (set, note) = voxelize_noting(scene, &self.params())?;
         progress.finish();
-        if let (Resolution::TargetPatches(n), Some(why)) = (self.resolution, &note) {
+        if let Some(why) = &note {
+            let asked = match self.resolution {
+                Resolution::TargetPatches(n) => format!("TargetPatches({n})"),
+                Resolution::Adaptive(a) => format!("Adaptive(target: {})", a.target),
+                Resolution::VoxelSize(s) => format!("VoxelSize({s})"),
+            };
             progress.warn(&format!(
-                "voxelize: TargetPatches({n}) gave {} patches: {why}",
+                "voxelize: {asked} gave {} patches: {why}",
                 set.len()
             ));
         }
@@ -85,6 +90,13 @@ impl StageRun for VoxelizeKnobs {
             (None, Resolution::TargetPatches(n)) => (
                 n as u64,
                 format!("assumes TargetPatches({n}) gives {n} patches; re-checked after voxelize"),
+            ),
+            (None, Resolution::Adaptive(a)) => (
+                a.target as u64,
+                format!(
+                    "assumes Adaptive(target: {}) gives {} patches; re-checked after voxelize",
+                    a.target, a.target
+                ),
             ),
             (None, Resolution::VoxelSize(s)) => (
                 state.triangles.max(1000),

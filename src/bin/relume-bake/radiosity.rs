@@ -12,6 +12,7 @@ use relume::pipeline::Stage;
 use relume::player::headless::args;
 use relume::player::light_spec::parse_light;
 use relume::player::Sun;
+use relume::radiosity::adaptive::AdaptiveParams;
 use relume::radiosity::formfactor::Estimator;
 use relume::radiosity::transport::{Bounces, Power};
 use relume::radiosity::voxelize::Resolution;
@@ -44,6 +45,10 @@ pub enum Command {
         /// Voxel edge length in scene units
         #[arg(long, value_name = "S", conflicts_with = "target_patches", value_parser = arg::positive_f64)]
         voxel_size: Option<f64>,
+        /// About N adaptive patches: refined where materials, geometry or light vary
+        /// (`Adaptive(target: N)` with its other knobs at their defaults)
+        #[arg(long, value_name = "N", conflicts_with_all = ["target_patches", "voxel_size"], value_parser = arg::at_least_one)]
+        adaptive: Option<u32>,
         /// Points per patch stored for the runtime's direct light (default 4)
         #[arg(long, value_name = "K", value_parser = arg::at_least_one)]
         samples_per_patch: Option<u32>,
@@ -161,14 +166,16 @@ pub fn run(cmd: &Command, json: bool, quiet: bool, ui: &crate::ui::Ui) -> Result
             baked_dir,
             target_patches,
             voxel_size,
+            adaptive,
             samples_per_patch,
             budget,
         } => {
             let d = VoxelizeKnobs::default();
-            let resolution = match (voxel_size, target_patches) {
-                (Some(s), _) => Resolution::VoxelSize(*s),
-                (None, Some(n)) => Resolution::TargetPatches(*n),
-                (None, None) => d.resolution,
+            let resolution = match (voxel_size, target_patches, adaptive) {
+                (Some(s), _, _) => Resolution::VoxelSize(*s),
+                (None, Some(n), _) => Resolution::TargetPatches(*n),
+                (None, None, Some(n)) => Resolution::Adaptive(AdaptiveParams::new(*n)),
+                (None, None, None) => d.resolution,
             };
             let knobs = VoxelizeKnobs {
                 resolution,

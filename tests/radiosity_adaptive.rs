@@ -1,0 +1,156 @@
+//! Adaptive patches (`Resolution::Adaptive`): patches never mix materials, the count lands in
+//! the target band, nothing leaks through a closed door, the output is the same for any
+//! thread count, and on the door-ajar scene they come closer to Mitsuba than the uniform grid.
+
+mod common;
+#[path = "support/room_light.rs"]
+mod room_light;
+
+use common::*;
+use relume::radiosity::adaptive::AdaptiveParams;
+use relume::radiosity::fixtures::random_soup;
+use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::PatchSet;
+use relume::scene::Scene;
+use serde_json::Value;
+
+fn adaptive(scene: &Scene, target: u32) -> PatchSet {
+    voxelize(
+        scene,
+        &VoxelizeParams {
+            resolution: Resolution::Adaptive(AdaptiveParams::new(target)),
+            samples_per_patch: 1,
+        },
+    )
+    .unwrap()
+}
+
+/// Largest per-channel albedo difference between two pieces of one patch, over all patches
+/// (brute force over the pieces' own triangles' materials).
+fn worst_mix(scene: &Scene, set: &PatchSet) -> f32 {
+    let mut worst: f32 = 0.0;
+    for p in &set.patches {
+        let albedos: Vec<[f32; 3]> = set
+            .patch_pieces(p)
+            .iter()
+            .map(|q| scene.materials[scene.triangle_material[q.triangle as usize] as usize].albedo)
+            .collect();
+        for a in &albedos {
+            for b in &albedos {
+                for c in 0..3 {
+                    worst = worst.max((a[c] - b[c]).abs());
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// On the door-ajar room (blue floor under a grey threshold, a cabinet against a wall) the
+/// uniform grid mixes albedos 0.3+ apart in one patch; adaptive patches never exceed the
+/// tolerance (0.1), at the same patch count.
+#[test]
+fn adaptive_patches_never_mix_materials() {
+    let scene = room_light::room("door-ajar");
+    let uniform = voxelize(
+        &scene,
+        &VoxelizeParams {
+            resolution: Resolution::TargetPatches(2000),
+            samples_per_patch: 1,
+        },
+    )
+    .unwrap();
+    let mixed = worst_mix(&scene, &uniform);
+    assert!(
+        mixed > 0.2,
+        "the uniform grid should mix materials here: {mixed}"
+    );
+    let set = adaptive(&scene, 2000);
+    let worst = worst_mix(&scene, &set);
+    eprintln!("uniform {mixed}, adaptive {worst} ({} patches)", set.len());
+    assert!(
+        worst <= 0.1 + 1e-6,
+        "adaptive patch mixes albedos {worst} apart"
+    );
+}
+
+/// `Adaptive(target: n)` lands within ±20 % of n on the bundled scenes (lit: refined by light)
+/// and on a random soup (no emitter: refined by size).
+#[test]
+fn adaptive_target_lands_within_twenty_percent() {
+    let scenes = [
+        ("cornell", room_light::room("cornell"), 600),
+        ("door-ajar", room_light::room("door-ajar"), 2000),
+        ("furnished-room", room_light::room("furnished-room"), 2000),
+        ("soup", random_soup(3000, 7), 1000),
+    ];
+    for (name, scene, target) in scenes {
+        let n = adaptive(&scene, target).len();
+        eprintln!("{name}: Adaptive({target}) -> {n}");
+        let miss = n as f64 / target as f64 - 1.0;
+        assert!(miss.abs() <= 0.2, "{name}: {n} patches for {target}");
+    }
+}
+
+/// Behind the closed door no light arrives with adaptive patches either: refinement splits
+/// cells only into octants re-clustered by visibility, so no patch spans the wall.
+#[test]
+fn adaptive_patches_keep_the_closed_room_dark() {
+    let scene = room_light::room("door-sealed");
+    let (light, patches) =
+        room_light::object_light_with(&scene, Resolution::Adaptive(AdaptiveParams::new(2000)));
+    eprintln!("door-sealed: {patches} adaptive patches");
+    let mut dark = 0;
+    for o in &light {
+        if o.name.starts_with("dark.") && o.name != "dark.door" {
+            dark += 1;
+            assert_eq!(o.max_patch_irradiance, 0.0, "{}", o.name);
+            assert_eq!(o.irradiance_patches, [0.0; 3], "{}", o.name);
+            assert_eq!(o.irradiance, [0.0; 3], "{}", o.name);
+        }
+    }
+    assert_eq!(dark, 6);
+}
+
+/// The same patches for 1 and 2 threads (the coarse bake is parallel).
+#[test]
+fn adaptive_patches_are_the_same_for_any_thread_count() {
+    let scene = room_light::room("door-ajar");
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| adaptive(&scene, 1000))
+    };
+    assert!(run(1) == run(2));
+}
+
+/// Per-object irradiance against Mitsuba 3 on the door-ajar scene at 4,000 patches: the
+/// uniform grid and adaptive patches side by side (the full curve: `ADAPTIVE=1 cargo bench
+/// --bench rooms_mitsuba`).
+#[test]
+fn adaptive_patches_come_closer_to_mitsuba_on_the_door_ajar() {
+    let reference: Value = serde_json::from_str(
+        &std::fs::read_to_string(data("tests/reference/door-ajar.mitsuba.json")).unwrap(),
+    )
+    .unwrap();
+    let scene = room_light::room("door-ajar");
+    let worst = |resolution| {
+        let (light, n) = room_light::object_light_with(&scene, resolution);
+        let mut worst: f64 = 0.0;
+        for (name, r) in reference.as_object().unwrap() {
+            let got = light.iter().find(|l| &l.name == name).unwrap();
+            let err = room_light::relative_error(got.irradiance_patches, r);
+            worst = err.iter().fold(worst, |w, e| w.max(e.abs()));
+        }
+        (worst, n)
+    };
+    let (uniform, nu) = worst(Resolution::TargetPatches(4000));
+    let (adaptive, na) = worst(Resolution::Adaptive(AdaptiveParams::new(4000)));
+    eprintln!("worst object: uniform {uniform:.4} ({nu} patches), adaptive {adaptive:.4} ({na})");
+    assert!(
+        adaptive < uniform,
+        "adaptive {adaptive} vs uniform {uniform}"
+    );
+}
