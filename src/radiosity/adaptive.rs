@@ -56,8 +56,11 @@ pub struct AdaptiveParams {
     pub base_share: f64,
 }
 
+/// Default `albedo_tolerance`.
+pub const ALBEDO_TOLERANCE: f64 = 0.1;
+
 fn default_albedo_tolerance() -> f64 {
-    0.1
+    ALBEDO_TOLERANCE
 }
 fn default_max_level() -> u8 {
     2

@@ -1,11 +1,16 @@
 //! The transfer from patches back to the full mesh: for every triangle corner, a short list of
 //! (patch, weight) whose weighted radiosity is the corner's smooth indirect light.
 //!
-//! For a corner at grid position `p` of a triangle with normal `n` and dominant axis `a`:
+//! Every patch has a *cell*: its voxel, or — where its (voxel, axis) group holds several patches
+//! (adaptive refinement, [`super::adaptive`], or clusters split by a thin wall) — the smallest
+//! dyadic sub-cube of the voxel (edge 2^−l, l ≤ [`MAX_CELL_LEVEL`]) holding its pieces. For a
+//! corner at grid position `p` of a triangle with normal `n` and dominant axis `a`:
 //!
-//! 1. Trilinear weights over the 8 voxels whose centres surround `p` (centres at half-integers).
-//! 2. In each of those voxels take the patch with the same axis `a` nearest to `p` (compatible
-//!    orientation), and keep it only when
+//! 1. Each patch with axis `a` in the 27 voxels around `p` gets the tent weight of its cell,
+//!    `Π_k max(0, 1 − |p_k − c_k| / s)` (centre c, edge s). On a grid of whole voxels these are
+//!    the trilinear weights over the 8 voxels whose centres surround `p`; where cells of
+//!    different sizes meet, each tent still falls to 0 continuously, so the blend has no seam.
+//! 2. A patch is kept only when
 //!    * its nearest point `q` lies within half a voxel of the triangle's plane (`|n·(q − p)| ≤ ½`):
 //!      a shelf above a floor does not light the floor, and
 //!    * the segment from `p` to `q`, both lifted off their surfaces, is unoccluded: a wall between
@@ -16,6 +21,7 @@
 //!
 //! The weights vary continuously with `p` along a surface, so the interpolated light is smooth.
 
+use super::clip::SNAP;
 use super::geometry::dominant_axis;
 use super::locate::{voxel_of, PatchLocator};
 use super::visibility::Visibility;
@@ -26,6 +32,48 @@ use rayon::prelude::*;
 
 /// Largest distance of a kept patch from the corner's plane, in voxels.
 const PLANE_DISTANCE: f64 = 0.5;
+/// Height (grid units) of the second leak test between patches that share a voxel.
+const RAISE: f64 = 0.05;
+/// Deepest sub-cube level of a patch's cell (the adaptive refinement's `max_level` limit).
+pub const MAX_CELL_LEVEL: u32 = 6;
+
+/// The cell (lowest corner, edge; grid units) of every patch of `set`.
+pub fn patch_cells(set: &PatchSet) -> Vec<(DVec3, f64)> {
+    let mut out = Vec::with_capacity(set.patches.len());
+    let mut start = 0;
+    while start < set.patches.len() {
+        let first = &set.patches[start];
+        let same = |p: &super::Patch| p.voxel == first.voxel && p.axis == first.axis;
+        let end = start + set.patches[start..].iter().take_while(|p| same(p)).count();
+        let voxel = DVec3::from(first.voxel.map(|v| v as f64));
+        for patch in &set.patches[start..end] {
+            if end - start == 1 {
+                out.push((voxel, 1.0));
+                continue;
+            }
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            for piece in set.patch_pieces(patch) {
+                for &v in &piece.vertices {
+                    lo = lo.min(DVec3::from(v) - voxel);
+                    hi = hi.max(DVec3::from(v) - voxel);
+                }
+            }
+            let (lo, hi) = (lo + DVec3::splat(SNAP), hi - DVec3::splat(SNAP));
+            let mut cell = (voxel, 1.0);
+            for level in 1..=MAX_CELL_LEVEL {
+                let s = 0.5f64.powi(level as i32);
+                let a = (lo / s).floor().max(DVec3::ZERO);
+                if a != (hi / s).floor().max(a) {
+                    break;
+                }
+                cell = (voxel + a * s, s);
+            }
+            out.push(cell);
+        }
+        start = end;
+    }
+    out
+}
 
 /// Per-corner transfer lists (`3 * triangle + corner`) for every scene triangle; degenerate
 /// triangles get empty lists. `vis` must be built over the same grid frame as `set`.
@@ -50,6 +98,8 @@ pub fn corner_patches(scene: &Scene, set: &PatchSet, vis: &Visibility) -> PatchL
 /// a whole wall. `vis` is the BVH of the voxelization ([`Visibility::for_patches`]).
 pub struct PointTransfer<'a> {
     locator: PatchLocator,
+    cells: Vec<(DVec3, f64)>,
+    albedo: Vec<[f32; 3]>,
     vis: &'a Visibility,
     frame: super::geometry::Frame,
     dims: [u32; 3],
@@ -67,6 +117,8 @@ impl<'a> PointTransfer<'a> {
     pub fn new(scene: &Scene, set: &PatchSet, vis: &'a Visibility) -> Self {
         PointTransfer {
             locator: PatchLocator::new(set, scene),
+            cells: patch_cells(set),
+            albedo: set.patches.iter().map(|p| p.albedo).collect(),
             vis,
             frame: set.frame(),
             dims: set.dims,
@@ -89,59 +141,61 @@ impl OnTriangle<'_, '_> {
     /// Weights (patch, weight summing to 1) of the point `p` (world) on the triangle.
     pub fn weights(&self, p: glam::Vec3) -> Vec<(u32, f32)> {
         let t = self.transfer;
-        corner_weights(
-            t.frame.to_grid(p.to_array()),
-            self.normal,
-            self.centre,
-            &t.locator,
-            t.vis,
-            t.dims,
-            t.lift,
-        )
+        corner_weights(t.frame.to_grid(p.to_array()), self.normal, self.centre, t)
     }
 }
 
-fn corner_weights(
-    p: DVec3,
-    n: DVec3,
-    centre: DVec3,
-    locator: &PatchLocator,
-    vis: &Visibility,
-    dims: [u32; 3],
-    lift: f64,
-) -> Vec<(u32, f32)> {
+fn corner_weights(p: DVec3, n: DVec3, centre: DVec3, t: &PointTransfer) -> Vec<(u32, f32)> {
+    let (locator, cells, vis, dims, lift) = (&t.locator, &t.cells, t.vis, t.dims, t.lift);
     let axis = dominant_axis(n);
     // The corner lifted off its surface and nudged into its triangle, so the leak test starts
     // in the open and not on an adjoining wall's plane.
     let inward = (centre - p).try_normalize().unwrap_or(DVec3::ZERO);
     let from = p + n * lift + inward * lift;
-    let g = p - DVec3::splat(0.5);
-    let base = g.floor();
-    let f = g - base;
+    let home = p.floor();
     let mut out: Vec<(u32, f64)> = Vec::with_capacity(8);
-    for corner in 0..8 {
-        let d = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
-        let w: f64 = (0..3)
-            .map(|a| if d[a] == 1 { f[a] } else { 1.0 - f[a] })
-            .product();
-        if w <= 0.0 {
-            continue;
-        }
-        let voxel = std::array::from_fn(|a| base[a] as i64 + d[a] as i64);
-        let Some((j, _, q)) = locator.nearest_in_voxel(p, voxel, axis) else {
-            continue;
-        };
-        if n.dot(q - p).abs() > PLANE_DISTANCE {
-            continue;
-        }
-        let qn = locator.piece_normal_near(j as usize, q);
-        let to = q + qn * lift + (p - q).try_normalize().unwrap_or(DVec3::ZERO) * lift;
-        if vis.occluded(from, to) {
-            continue;
-        }
-        match out.iter_mut().find(|e| e.0 == j) {
-            Some(e) => e.1 += w,
-            None => out.push((j, w)),
+    for k in 0..27i64 {
+        let voxel: [i64; 3] =
+            std::array::from_fn(|a| home[a] as i64 + (k / 3i64.pow(a as u32)) % 3 - 1);
+        let group = locator.candidates(voxel, axis);
+        let shared = group.len() > 1;
+        // Where a voxel holds several patches of this orientation, its nearest one is blended
+        // with those of the same material in cells apart from its own (the octants of an
+        // adaptive split); a patch of another material, or a cluster sharing its cell, is not
+        // (a threshold under a closed door does not light the floor beside it).
+        let own = shared
+            .then(|| locator.nearest_in_voxel(p, voxel, axis))
+            .flatten()
+            .map(|c| c.0 as usize);
+        for j in group {
+            if let Some(k) = own {
+                if j != k && !(same_material(&t.albedo, j, k) && apart(cells[j], cells[k])) {
+                    continue;
+                }
+            }
+            let (lo, size) = cells[j];
+            let centre = lo + DVec3::splat(0.5 * size);
+            let w: f64 = (0..3)
+                .map(|a| (1.0 - (p[a] - centre[a]).abs() / size).max(0.0))
+                .product();
+            if w <= 0.0 {
+                continue;
+            }
+            let (_, q) = locator.distance(p, j);
+            if n.dot(q - p).abs() > PLANE_DISTANCE {
+                continue;
+            }
+            let qn = locator.piece_normal_near(j, q);
+            let to = q + qn * lift + (p - q).try_normalize().unwrap_or(DVec3::ZERO) * lift;
+            if vis.occluded(from, to) {
+                continue;
+            }
+            // Patches sharing a voxel are blended (not just the nearest taken), so a pair that
+            // meets under a wall's edge is tested again higher up, where the wall is.
+            if shared && vis.occluded(from + n * RAISE, to + qn * RAISE) {
+                continue;
+            }
+            out.push((j as u32, w));
         }
     }
     let total: f64 = out.iter().map(|e| e.1).sum();
@@ -161,6 +215,16 @@ fn corner_weights(
         })
         .map(|j| vec![(j, 1.0)])
         .unwrap_or_default()
+}
+
+/// Albedos of patches `a` and `b` within the adaptive refinement's default tolerance.
+fn same_material(albedo: &[[f32; 3]], a: usize, b: usize) -> bool {
+    (0..3).all(|c| (albedo[a][c] - albedo[b][c]).abs() as f64 <= super::adaptive::ALBEDO_TOLERANCE)
+}
+
+/// Whether two cells (lowest corner, edge) have no interior in common.
+fn apart(a: (DVec3, f64), b: (DVec3, f64)) -> bool {
+    (0..3).any(|k| a.0[k] + a.1 <= b.0[k] + SNAP || b.0[k] + b.1 <= a.0[k] + SNAP)
 }
 
 /// Interpolate per-patch values (e.g. radiosity of one channel) to every triangle corner.
