@@ -330,6 +330,14 @@ fn degenerate_triangles_are_reported_and_bad_knobs_located() {
             "TargetPatches(0)",
         ),
         ("Voxelize(resolution: VoxelSize(-1.0)),", "VoxelSize(-1)"),
+        (
+            "Voxelize(resolution: Adaptive(target: 600, albedo_tolerance: -1.0)),",
+            "albedo_tolerance -1",
+        ),
+        (
+            "Voxelize(resolution: Adaptive(target: 600, base_share: 0.0)),",
+            "base_share 0",
+        ),
         ("Voxelize(), FormFactors(samples: 0),", "at least 1"),
         (
             "Voxelize(), FormFactors(), Transport(bounces: Finite(0)),",
@@ -353,4 +361,48 @@ fn degenerate_triangles_are_reported_and_bad_knobs_located() {
             assert!(err.contains("bad.ron:4:"), "{stage}: {err}");
         }
     }
+}
+
+/// `Adaptive(target: n)` from a pipeline file and `voxelize --adaptive N` from the command line
+/// both land within ±20 % of n, and say so in the manifest.
+#[test]
+fn adaptive_resolution_from_pipeline_and_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = data("scenes/cornell-box/cornell_box.obj");
+    let p = pipeline(
+        dir.path(),
+        "adaptive",
+        &obj,
+        "Voxelize(resolution: Adaptive(target: 300, max_level: 1)),",
+    );
+    let out = dir.path().join("adaptive_out");
+    expect_code(
+        &bake(dir.path(), &["-q", "run", s(&p), "--out", s(&out)]),
+        0,
+    );
+    let count = |dir: &Path| -> f64 {
+        let m = std::fs::read_to_string(dir.join("manifest.ron")).unwrap();
+        let at = m.find("\"patches\": ").unwrap() + "\"patches\": ".len();
+        m[at..]
+            .split(|c: char| c != '.' && !c.is_ascii_digit())
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let n = count(&out);
+    assert!(
+        (n / 300.0 - 1.0).abs() <= 0.2,
+        "{n} patches for Adaptive(target: 300)"
+    );
+    let o = bake(
+        dir.path(),
+        &["-q", "voxelize", s(&out), "--adaptive", "500"],
+    );
+    expect_code(&o, 0);
+    let n = count(&out);
+    assert!(
+        (n / 500.0 - 1.0).abs() <= 0.2,
+        "{n} patches for --adaptive 500"
+    );
 }

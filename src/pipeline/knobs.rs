@@ -17,7 +17,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VoxelizeKnobs {
-    /// `TargetPatches(n)` (the stage picks the voxel size) or `VoxelSize(s)` in scene units.
+    /// `TargetPatches(n)` (the stage picks the voxel size), `VoxelSize(s)` in scene units, or
+    /// `Adaptive(target: n, ..)` (refined where materials, geometry or light vary).
     #[serde(
         default = "default_resolution",
         deserialize_with = "checks::de::resolution"

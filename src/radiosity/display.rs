@@ -29,13 +29,24 @@ pub fn display_mesh_of(scene: &Scene, set: &PatchSet) -> (Scene, PatchLists) {
 }
 
 /// The display mesh of `scene` (voxelized as `set`) with no edge longer than `max_edge` (scene
-/// units; at most [`MAX_SPLIT`] steps per edge), and its per-corner transfer lists.
+/// units; at most [`MAX_SPLIT`] steps per edge) times the edge of the smallest patch cell the
+/// triangle feeds ([`super::corners::patch_cells`]: 1 on a uniform grid, down to 2^−max_level
+/// where adaptive patches refined a voxel), and its per-corner transfer lists.
 pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, PatchLists) {
+    let cells = super::corners::patch_cells(set);
     let split: Vec<usize> = (0..scene.triangles.len())
         .map(|t| {
             if scene.is_degenerate(t) {
                 return 1;
             }
+            let finest = set
+                .triangle_patches
+                .list(t)
+                .0
+                .iter()
+                .map(|&j| cells[j as usize].1)
+                .fold(1.0, f64::min);
+            let max_edge = max_edge * finest;
             let c = scene.corners(t);
             let longest = (0..3)
                 .map(|k| (c[(k + 1) % 3] - c[k]).length() as f64)
