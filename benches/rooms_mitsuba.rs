@@ -13,7 +13,7 @@
 //!
 //! Run: `cargo bench --bench rooms_mitsuba` (`PATCHES=1000,2000,4000,8000`,
 //! `SCENE=door-ajar|cornell`, `ADAPTIVE=1` for `Resolution::Adaptive` instead of
-//! `TargetPatches`).
+//! `TargetPatches`, `BASE_SHARE=0.5` its base grid's share of the target).
 
 #[path = "../tests/support/room_light.rs"]
 mod room_light;
@@ -28,6 +28,7 @@ fn main() {
     let name: String = util::env("SCENE", "door-ajar".to_string());
     let targets: Vec<u32> = util::env_list("PATCHES", "1000,2000,4000,8000");
     let adaptive = util::env("ADAPTIVE", 0u32) == 1;
+    let base_share: f64 = util::env("BASE_SHARE", AdaptiveParams::new(1).base_share);
     let scene = room_light::room(&name);
     let reference: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(format!("{root}/tests/reference/{name}.mitsuba.json")).unwrap(),
@@ -61,7 +62,10 @@ fn main() {
     for &target in &targets {
         let t0 = Instant::now();
         let resolution = if adaptive {
-            Resolution::Adaptive(AdaptiveParams::new(target))
+            Resolution::Adaptive(AdaptiveParams {
+                base_share,
+                ..AdaptiveParams::new(target)
+            })
         } else {
             Resolution::TargetPatches(target)
         };

@@ -144,7 +144,7 @@ pub fn voxelize_noting(
             (dims, frame, pieces, vis, groups)
         }
         Resolution::Adaptive(a) => {
-            let (dims, frame, mut pieces, vis, cells) = adaptive_base(&search, &grid, scene, &a)?;
+            let ((dims, frame, mut pieces, vis), cells) = adaptive_base(&search, &grid, scene, &a)?;
             let materials = cells.len();
             let (cells, report) =
                 adaptive::refine(&mut pieces, cells, dims, &vis, &a, |cells, pieces| {
@@ -213,7 +213,7 @@ fn adaptive_base(
     grid: &dyn Fn(f64) -> Result<Grid>,
     scene: &Scene,
     a: &AdaptiveParams,
-) -> Result<([u32; 3], Frame, Vec<(u64, Piece)>, Visibility, Vec<Cell>)> {
+) -> Result<(Grid, Vec<Cell>)> {
     let mut base = (a.target as f64 * a.base_share).max(1.0);
     for attempt in 1.. {
         let choice = search.for_target(base.round().max(1.0) as u32);
@@ -221,7 +221,7 @@ fn adaptive_base(
         let groups = clusters(&pieces, &vis);
         let (cells, _) = adaptive::by_material(scene, groups, &pieces, dims, a.albedo_tolerance);
         if cells.len() <= a.target as usize || attempt == 3 {
-            return Ok((dims, frame, pieces, vis, cells));
+            return Ok(((dims, frame, pieces, vis), cells));
         }
         base *= 0.8 * a.target as f64 / cells.len() as f64;
     }
