@@ -180,6 +180,21 @@ impl PatchSet {
         &self.pieces[patch.first_piece as usize..(patch.first_piece + patch.piece_count) as usize]
     }
 
+    /// An area sampler over a patch's pieces (grid coordinates).
+    pub fn piece_sampler(&self, patch: &Patch) -> geometry::AreaSampler {
+        let polys: Vec<(Vec<glam::DVec3>, glam::DVec3)> = self
+            .patch_pieces(patch)
+            .iter()
+            .map(|p| {
+                (
+                    p.vertices.iter().map(|&v| glam::DVec3::from(v)).collect(),
+                    glam::DVec3::from(p.normal),
+                )
+            })
+            .collect();
+        geometry::AreaSampler::new(polys.iter().map(|(p, n)| (p.as_slice(), *n)))
+    }
+
     /// The grid frame of this patch set.
     pub fn frame(&self) -> geometry::Frame {
         geometry::Frame {

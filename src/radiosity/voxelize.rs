@@ -173,7 +173,7 @@ pub fn voxelize_noting(
     // Direct-light sample points and the triangle → patch map.
     set.samples_per_patch = params.samples_per_patch;
     for (i, patch) in set.patches.iter().enumerate() {
-        let sampler = piece_sampler(&set, patch);
+        let sampler = set.piece_sampler(patch);
         let mut rng = geometry::item_rng(SAMPLE_SEED, i as u64, 0);
         let k = params.samples_per_patch as usize;
         for (u, v) in rng.jittered(k) {
@@ -350,21 +350,6 @@ fn build_patch(
         piece_count: members.len() as u32,
         objects,
     }
-}
-
-/// An area sampler over a patch's pieces (grid coordinates).
-pub fn piece_sampler(set: &PatchSet, patch: &Patch) -> geometry::AreaSampler {
-    let polys: Vec<(Vec<DVec3>, DVec3)> = set
-        .patch_pieces(patch)
-        .iter()
-        .map(|p| {
-            (
-                p.vertices.iter().map(|&v| DVec3::from(v)).collect(),
-                DVec3::from(p.normal),
-            )
-        })
-        .collect();
-    geometry::AreaSampler::new(polys.iter().map(|(p, n)| (p.as_slice(), *n)))
 }
 
 /// For every scene triangle, the patches its visible pieces feed and the area (world units) each.

@@ -21,7 +21,6 @@ pub mod reciprocal;
 
 use super::locate::PatchLocator;
 use super::visibility::Visibility;
-use super::voxelize::piece_sampler;
 use super::PatchSet;
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -98,7 +97,7 @@ pub struct Context {
 
 impl Context {
     pub fn new(scene: &Scene, set: &PatchSet) -> Self {
-        let samplers = set.patches.iter().map(|p| piece_sampler(set, p)).collect();
+        let samplers = set.patches.iter().map(|p| set.piece_sampler(p)).collect();
         Context {
             samplers,
             locator: PatchLocator::new(set, scene),
@@ -211,7 +210,7 @@ pub fn assemble(
     let areas: Vec<f64> = set
         .patches
         .iter()
-        .map(|p| piece_sampler(set, p).area)
+        .map(|p| set.piece_sampler(p).area)
         .collect();
     Ok(assemble_with(&areas, params, blocks))
 }
