@@ -145,13 +145,16 @@ fn check_jpeg_complete(path: &Path, bytes: &[u8]) -> Result<()> {
 /// scan data with zeros). In a Huffman-coded JPEG (baseline, extended, progressive or lossless:
 /// SOF0–3, 5–7) every 8×8 block of every component has its DC coefficient coded, at least one
 /// bit (a Huffman code is 1–16 bits long), so the file holds at least one bit per block of the
-/// component with the fewest blocks. Arithmetic-coded files (which the decoder refuses anyway)
-/// and files without a frame header are left to the decoder.
+/// component with the fewest blocks. Where no frame header is found (the decoder found one:
+/// it gave the size), the bound assumes the deepest subsampling a frame can declare (4:1 each
+/// way). Arithmetic-coded files are left to the decoder, which refuses them.
 fn check_jpeg_size(path: &Path, bytes: &[u8], w: u64, h: u64) -> Result<()> {
-    let Some(frame) = jpeg_frame_header(bytes) else {
-        return Ok(());
+    let frame = match jpeg_frame_header(bytes) {
+        Frame::Huffman(frame) => frame,
+        Frame::Arithmetic => return Ok(()),
+        Frame::NotFound => &[],
     };
-    let factors: Vec<(u64, u64)> = frame
+    let mut factors: Vec<(u64, u64)> = frame
         .get(8..)
         .unwrap_or(&[])
         .chunks_exact(3)
@@ -159,6 +162,9 @@ fn check_jpeg_size(path: &Path, bytes: &[u8], w: u64, h: u64) -> Result<()> {
         .map(|c| ((c[1] >> 4) as u64, (c[1] & 15) as u64))
         .filter(|&(hf, vf)| hf > 0 && vf > 0)
         .collect();
+    if factors.is_empty() {
+        factors = vec![(1, 1), (4, 4)];
+    }
     let hmax = factors.iter().map(|f| f.0).max().unwrap_or(1);
     let vmax = factors.iter().map(|f| f.1).max().unwrap_or(1);
     let blocks = factors
@@ -179,10 +185,23 @@ fn check_jpeg_size(path: &Path, bytes: &[u8], w: u64, h: u64) -> Result<()> {
     Ok(())
 }
 
-/// The segment of a Huffman-coded JPEG's frame header (SOF0–3, 5–7) after its marker: length (2
-/// bytes), precision (1), height (2), width (2), component count (1), then (id, sampling
-/// factors, table) per component from byte 8.
-fn jpeg_frame_header(bytes: &[u8]) -> Option<&[u8]> {
+/// What [`jpeg_frame_header`] found.
+enum Frame<'a> {
+    /// The segment of a Huffman-coded frame header (SOF0–3, 5–7) after its marker: length (2
+    /// bytes), precision (1), height (2), width (2), component count (1), then (id, sampling
+    /// factors, table) per component from byte 8.
+    Huffman(&'a [u8]),
+    /// An arithmetic-coded frame header (SOF9–11, 13–15).
+    Arithmetic,
+    /// No frame header before the first scan, or a segment running past the end.
+    NotFound,
+}
+
+/// The frame header of a JPEG, walking its segments as decoders do: bytes between segments,
+/// fill bytes (FF FF), `FF 00` and the markers that carry no length (TEM, RST0–7, SOI) are
+/// skipped (AFL: a stray `FF 00` read as a segment with a length hid the frame of a 541-byte
+/// file declaring 184 M texels, which the decoder found and filled for 23 s).
+fn jpeg_frame_header(bytes: &[u8]) -> Frame<'_> {
     let mut i = 2; // after SOI
     while i + 4 <= bytes.len() {
         if bytes[i] != 0xFF {
@@ -190,19 +209,29 @@ fn jpeg_frame_header(bytes: &[u8]) -> Option<&[u8]> {
             continue;
         }
         let marker = bytes[i + 1];
-        if marker == 0xFF {
-            i += 1; // fill byte
-            continue;
+        match marker {
+            0xFF => {
+                i += 1; // fill byte
+                continue;
+            }
+            0x00 | 0x01 | 0xD0..=0xD8 => {
+                i += 2; // not a segment: no length follows
+                continue;
+            }
+            _ => {}
         }
         let len = u16::from_be_bytes([bytes[i + 2], bytes[i + 3]]) as usize;
-        let body = bytes.get(i + 2..i + 2 + len)?;
+        let Some(body) = bytes.get(i + 2..i + 2 + len) else {
+            return Frame::NotFound;
+        };
         match marker {
-            0xC0..=0xC3 | 0xC5..=0xC7 => return Some(body),
-            0xC9..=0xCB | 0xCD..=0xCF | 0xDA | 0xD9 => return None,
+            0xC0..=0xC3 | 0xC5..=0xC7 => return Frame::Huffman(body),
+            0xC9..=0xCB | 0xCD..=0xCF => return Frame::Arithmetic,
+            0xDA | 0xD9 => return Frame::NotFound,
             _ => i += 2 + len,
         }
     }
-    None
+    Frame::NotFound
 }
 
 /// Take one channel of an RGB image whose channels are all equal; refuse real colour images.
@@ -439,4 +468,49 @@ fn read_raw(path: &Path, size: Option<[usize; 2]>) -> Result<RawGrid> {
         georef: None,
         cell_size: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// SOF0 of a `w`x`h` one-component frame (sampling 1x1).
+    fn sof0(w: u16, h: u16) -> Vec<u8> {
+        let mut s = vec![0xFF, 0xC0, 0, 11, 8];
+        s.extend(h.to_be_bytes());
+        s.extend(w.to_be_bytes());
+        s.extend([1, 1, 0x11, 0]);
+        s
+    }
+
+    #[test]
+    fn the_segment_walk_skips_what_carries_no_length() {
+        // SOI, a stray FF 00, TEM, RST3, fill bytes, then the frame.
+        let mut bytes = vec![
+            0xFF, 0xD8, 0xFF, 0x00, 0x04, 0x05, 0xFF, 0x01, 0xFF, 0xD3, 0xFF,
+        ];
+        bytes.extend(sof0(640, 480));
+        match jpeg_frame_header(&bytes) {
+            Frame::Huffman(body) => assert_eq!(&body[3..7], &[1, 224, 2, 128]),
+            _ => panic!("frame header not found"),
+        }
+    }
+
+    #[test]
+    fn the_size_bound_holds_without_a_frame_header() {
+        let path = Path::new("x.jpg");
+        // No frame: 4:1 subsampling assumed, 4096x4096 -> 128x128 blocks -> 2,048 bytes.
+        let bytes = vec![0xFF, 0xD8, 0xFF, 0xDA, 0, 2];
+        assert!(check_jpeg_size(path, &bytes, 4096, 4096).is_err());
+        let mut big = bytes.clone();
+        big.resize(2048, 0);
+        assert!(check_jpeg_size(path, &big, 4096, 4096).is_ok());
+        // With the frame: one bit per 8x8 block of the one component (512x512 blocks).
+        let mut framed = vec![0xFF, 0xD8];
+        framed.extend(sof0(4096, 4096));
+        framed.resize(32767, 0);
+        assert!(check_jpeg_size(path, &framed, 4096, 4096).is_err());
+        framed.resize(32768, 0);
+        assert!(check_jpeg_size(path, &framed, 4096, 4096).is_ok());
+    }
 }
