@@ -5,6 +5,8 @@
 //!
 //! - [`radiosity`]: patch count, form-factor estimator × samples, bounces (reference: the densest
 //!   / most-sampled setting of the run, and the f64 Gauss–Seidel solver for the transport);
+//!   per-object irradiance of uniform and adaptive patches ([`radiosity_objects`]; reference: an
+//!   independent renderer's, read from a file);
 //! - [`compression`]: reorder passes, split percentage × dense encoding (reference: the
 //!   uncompressed transport and its dense mat-vec);
 //! - [`terrain`]: exact vs accelerated hard shadows at several map sizes and sun elevations,
@@ -20,6 +22,7 @@ pub mod compression;
 pub mod inputs;
 pub mod plot;
 pub mod radiosity;
+pub mod radiosity_objects;
 pub mod report;
 pub mod soft_shadows;
 pub mod terrain;

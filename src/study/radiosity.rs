@@ -14,9 +14,10 @@
 //! - **bounces**: one patch set and F; `Finite(k)`, `Infinite`, `Auto(tol)`. Reference: the f64
 //!   Gauss–Seidel solution of `B = E + diag(ρ) F B` ([`crate::radiosity::reference`]).
 
+use super::radiosity_objects::{objects_sweep, ObjectReference, ObjectsConfig};
 use super::timing::timed;
 use super::{Column, ErrorStats, Format, Measure, Setting, Sweep};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::limits::default_max_memory;
 use crate::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
 use crate::progress::{Progress, Silent};
@@ -49,6 +50,28 @@ pub struct RadiosityConfig {
     pub bounces: Vec<Bounces>,
     /// Seed of the form-factor estimators.
     pub seed: u64,
+    /// Which sweeps run, in this order.
+    pub sweeps: Vec<RadiositySweep>,
+    /// The per-object sweep's reference (and the file it came from) and knobs.
+    pub objects: Option<ObjectsStudy>,
+}
+
+/// One sweep of the radiosity study.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RadiositySweep {
+    Patches,
+    Estimator,
+    Bounces,
+    /// Per-object irradiance against an independent renderer, uniform vs adaptive patches.
+    Objects,
+}
+
+/// The per-object sweep's inputs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectsStudy {
+    pub reference: ObjectReference,
+    pub source: std::path::PathBuf,
+    pub config: ObjectsConfig,
 }
 
 impl RadiosityConfig {
@@ -63,6 +86,8 @@ impl RadiosityConfig {
             reference_samples: 16384,
             bounces: standard_bounces(),
             seed: 0,
+            sweeps: standard_sweeps(),
+            objects: None,
         }
     }
 
@@ -77,8 +102,18 @@ impl RadiosityConfig {
             reference_samples: 4096,
             bounces: standard_bounces(),
             seed: 0,
+            sweeps: standard_sweeps(),
+            objects: None,
         }
     }
+}
+
+fn standard_sweeps() -> Vec<RadiositySweep> {
+    vec![
+        RadiositySweep::Patches,
+        RadiositySweep::Estimator,
+        RadiositySweep::Bounces,
+    ]
 }
 
 fn standard_bounces() -> Vec<Bounces> {
@@ -174,12 +209,40 @@ fn area_weights(set: &PatchSet) -> Vec<f64> {
     [a.clone(), a.clone(), a].concat()
 }
 
-/// All three radiosity sweeps on `scene`.
+/// The radiosity sweeps `cfg.sweeps` names on `scene` (the bounces sweep runs on the estimator
+/// sweep's patches and form factors, so it runs that sweep too).
 pub fn run(scene: &Scene, cfg: &RadiosityConfig, progress: &dyn Progress) -> Result<Vec<Sweep>> {
-    let patches = patch_sweep(scene, cfg, progress)?;
-    let (estimator, set, f) = estimator_sweep(scene, cfg, progress)?;
-    let bounces = bounce_sweep(&set, &f, cfg, progress)?;
-    Ok(vec![patches, estimator, bounces])
+    let wants = |s| cfg.sweeps.contains(&s);
+    let objects = match (&cfg.objects, wants(RadiositySweep::Objects)) {
+        (Some(o), true) => Some(o),
+        (None, true) => return Err(Error::knob(
+            "the per-object sweep needs a reference of per-object irradiance (--objects-reference FILE)",
+        )),
+        _ => None,
+    };
+    let mut out = Vec::new();
+    if wants(RadiositySweep::Patches) {
+        out.push(patch_sweep(scene, cfg, progress)?);
+    }
+    if wants(RadiositySweep::Estimator) || wants(RadiositySweep::Bounces) {
+        let (estimator, set, f) = estimator_sweep(scene, cfg, progress)?;
+        if wants(RadiositySweep::Estimator) {
+            out.push(estimator);
+        }
+        if wants(RadiositySweep::Bounces) {
+            out.push(bounce_sweep(&set, &f, cfg, progress)?);
+        }
+    }
+    if let Some(o) = objects {
+        out.push(objects_sweep(
+            scene,
+            &o.reference,
+            &o.source,
+            &o.config,
+            progress,
+        )?);
+    }
+    Ok(out)
 }
 
 /// The patch-count sweep.

@@ -5,7 +5,9 @@
 use crate::ui::Ui;
 use clap::{Args, Subcommand};
 use relume::error::exit;
-use relume::study::{self, atmosphere, compression, inputs, radiosity, report, terrain, Study};
+use relume::study::{
+    self, atmosphere, compression, inputs, radiosity, radiosity_objects, report, terrain, Study,
+};
 use relume::Result;
 use std::path::PathBuf;
 
@@ -22,7 +24,8 @@ pub struct StudyArgs {
 
 #[derive(Subcommand)]
 pub enum Which {
-    /// Patch count, form-factor estimator × samples, bounces (error of B = S·E)
+    /// Patch count, form-factor estimator × samples, bounces (error of B = S·E); per-object
+    /// irradiance of uniform vs adaptive patches against a reference
     #[command(after_help = STUDY_HELP)]
     Radiosity(RadiosityArgs),
     /// Reorder passes, split percentage × dense encoding (error of the decoded S and of S·E)
@@ -76,9 +79,39 @@ pub struct RadiosityArgs {
     pub common: Common,
     #[command(flatten)]
     pub source: SceneSource,
-    /// Target patch counts of the patch sweep, e.g. 150,600,2400 (the largest is the reference)
+    /// Target patch counts of the patch sweep, e.g. 150,600,2400 (the largest is the
+    /// reference), and of the per-object sweep
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub patches: Option<Vec<u32>>,
+    /// Per-object irradiance of the scene by an independent renderer (JSON:
+    /// {"object": {"mean": [r, g, b], "stderr": [r, g, b]}, ...}, as
+    /// tests/support/mitsuba_objects.py writes it): adds the per-object sweep, uniform vs
+    /// adaptive patches
+    #[arg(long, value_name = "FILE")]
+    pub objects_reference: Option<PathBuf>,
+    /// Sweeps to run (default: patches,estimator,bounces, and objects with --objects-reference)
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub sweeps: Option<Vec<SweepName>>,
+}
+
+/// A sweep of `study radiosity`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SweepName {
+    Patches,
+    Estimator,
+    Bounces,
+    Objects,
+}
+
+impl SweepName {
+    fn sweep(self) -> radiosity::RadiositySweep {
+        match self {
+            SweepName::Patches => radiosity::RadiositySweep::Patches,
+            SweepName::Estimator => radiosity::RadiositySweep::Estimator,
+            SweepName::Bounces => radiosity::RadiositySweep::Bounces,
+            SweepName::Objects => radiosity::RadiositySweep::Objects,
+        }
+    }
 }
 
 #[derive(Args)]
@@ -185,6 +218,25 @@ pub fn run(args: &StudyArgs, ui: &Ui, json: bool, quiet: bool) -> Result<i32> {
             };
             if let Some(p) = &a.patches {
                 cfg.patch_targets = p.clone();
+            }
+            if let Some(path) = &a.objects_reference {
+                let mut config = if quick {
+                    radiosity_objects::ObjectsConfig::quick()
+                } else {
+                    radiosity_objects::ObjectsConfig::full()
+                };
+                if let Some(p) = &a.patches {
+                    config.targets = p.clone();
+                }
+                cfg.objects = Some(radiosity::ObjectsStudy {
+                    reference: radiosity_objects::read_reference(path)?,
+                    source: path.clone(),
+                    config,
+                });
+                cfg.sweeps.push(radiosity::RadiositySweep::Objects);
+            }
+            if let Some(s) = &a.sweeps {
+                cfg.sweeps = s.iter().map(|s| s.sweep()).collect();
             }
             Study::new("radiosity", name, quick, radiosity::run(&scene, &cfg, ui)?)
         }
