@@ -303,14 +303,7 @@ fn flatness(c: &Cell, pieces: &[(u64, Piece)]) -> f64 {
 }
 
 fn centroid(c: &Cell, pieces: &[(u64, Piece)]) -> (DVec3, DVec3) {
-    let (mut sum, mut normal, mut area) = (DVec3::ZERO, DVec3::ZERO, 0.0);
-    for &i in &c.members {
-        let p = &pieces[i].1;
-        let poly: Vec<DVec3> = p.vertices.iter().map(|&v| DVec3::from(v)).collect();
-        sum += p.area * geometry::centroid(&poly);
-        normal += p.area * DVec3::from(p.normal);
-        area += p.area;
-    }
+    let (area, sum, normal) = super::piece_moments(c.members.iter().map(|&i| &pieces[i].1));
     (
         sum / area.max(f64::MIN_POSITIVE),
         normal.normalize_or_zero(),

@@ -115,9 +115,19 @@ pub struct OnTriangle<'t, 'a> {
 
 impl<'a> PointTransfer<'a> {
     pub fn new(scene: &Scene, set: &PatchSet, vis: &'a Visibility) -> Self {
+        Self::with_cells(scene, set, vis, patch_cells(set))
+    }
+
+    /// [`PointTransfer::new`] with the [`patch_cells`] of `set` already computed.
+    pub fn with_cells(
+        scene: &Scene,
+        set: &PatchSet,
+        vis: &'a Visibility,
+        cells: Vec<(DVec3, f64)>,
+    ) -> Self {
         PointTransfer {
             locator: PatchLocator::new(set, scene),
-            cells: patch_cells(set),
+            cells,
             albedo: set.patches.iter().map(|p| p.albedo).collect(),
             vis,
             frame: set.frame(),

@@ -58,7 +58,7 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
         return (scene.clone(), set.corners.clone());
     }
     let vis = Visibility::for_patches(scene, set);
-    let transfer = PointTransfer::new(scene, set, &vis);
+    let transfer = PointTransfer::with_cells(scene, set, &vis, cells);
     // Per scene triangle: its sub-triangles' corner positions and lists, three per sub-triangle.
     type Part = (Vec<[f32; 3]>, Vec<Vec<(u32, f32)>>);
     let parts: Vec<Part> = (0..scene.triangles.len())

@@ -104,6 +104,23 @@ pub struct Piece {
     pub area: f64,
 }
 
+/// Area-weighted sums of some pieces, in the order given: (area, Σ area·centroid,
+/// Σ area·normal) in grid units. A patch's centroid is the second over the first, its normal the
+/// third normalised (`voxelize`, and the adaptive refinement's cells).
+pub fn piece_moments<'a>(
+    pieces: impl IntoIterator<Item = &'a Piece>,
+) -> (f64, glam::DVec3, glam::DVec3) {
+    use glam::DVec3;
+    let (mut area, mut centroid, mut normal) = (0.0, DVec3::ZERO, DVec3::ZERO);
+    for p in pieces {
+        let poly: Vec<DVec3> = p.vertices.iter().map(|&v| DVec3::from(v)).collect();
+        area += p.area;
+        centroid += p.area * geometry::centroid(&poly);
+        normal += p.area * DVec3::from(p.normal);
+    }
+    (area, centroid, normal)
+}
+
 /// A point on a surface with its unit normal.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SurfacePoint {

@@ -319,17 +319,13 @@ fn build_patch(
 ) -> Patch {
     let (voxel, axis) = split_key(key, dims);
     let first_piece = set.pieces.len() as u32;
-    let (mut area, mut centroid, mut normal) = (0.0, DVec3::ZERO, DVec3::ZERO);
+    let (area, centroid, normal) = super::piece_moments(members.iter().map(|&i| &pieces[i].1));
     let (mut albedo, mut emission) = (DVec3::ZERO, DVec3::ZERO);
     let mut objects = Vec::new();
     for &i in members {
         let p = &pieces[i].1;
-        let poly: Vec<DVec3> = p.vertices.iter().map(|&v| DVec3::from(v)).collect();
         let t = p.triangle as usize;
         let m = &scene.materials[scene.triangle_material[t] as usize];
-        area += p.area;
-        centroid += p.area * geometry::centroid(&poly);
-        normal += p.area * DVec3::from(p.normal);
         albedo += p.area * glam::Vec3::from(m.albedo).as_dvec3();
         emission += p.area * glam::Vec3::from(m.emission).as_dvec3();
         objects.push(scene.triangle_object[t]);
