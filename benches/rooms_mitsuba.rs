@@ -13,13 +13,16 @@
 //!
 //! Run: `cargo bench --bench rooms_mitsuba` (`PATCHES=1000,2000,4000,8000`,
 //! `SCENE=door-ajar|cornell`, `ADAPTIVE=1` for `Resolution::Adaptive` instead of
-//! `TargetPatches`, `BASE_SHARE=0.5` its base grid's share of the target).
+//! `TargetPatches`, `BASE_SHARE=0.5` its base grid's share of the target, `ESTIMATOR=hemisphere|
+//! pairwise` and `SAMPLES=n` for another form-factor estimator than the default reciprocal
+//! hemisphere with 4,096 rays).
 
 #[path = "../tests/support/room_light.rs"]
 mod room_light;
 mod util;
 
 use relume::radiosity::adaptive::AdaptiveParams;
+use relume::radiosity::formfactor::{Estimator, FormFactorParams};
 use relume::radiosity::voxelize::Resolution;
 use std::time::Instant;
 
@@ -29,6 +32,16 @@ fn main() {
     let targets: Vec<u32> = util::env_list("PATCHES", "1000,2000,4000,8000");
     let adaptive = util::env("ADAPTIVE", 0u32) == 1;
     let base_share: f64 = util::env("BASE_SHARE", AdaptiveParams::new(1).base_share);
+    let estimator = match util::env("ESTIMATOR", "reciprocal".to_string()).as_str() {
+        "hemisphere" => Estimator::Hemisphere,
+        "pairwise" => Estimator::Pairwise,
+        _ => Estimator::HemisphereReciprocal,
+    };
+    let ff = FormFactorParams {
+        estimator,
+        samples: util::env("SAMPLES", estimator.default_samples()),
+        seed: 0,
+    };
     let scene = room_light::room(&name);
     let reference: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(format!("{root}/tests/reference/{name}.mitsuba.json")).unwrap(),
@@ -37,9 +50,10 @@ fn main() {
     let objects: Vec<&String> = reference.as_object().unwrap().keys().collect();
     println!(
         "{name}: {} triangles; relume per-object irradiance (patches | corner-interpolated) vs \
-         Mitsuba, relative error, mean over RGB; {} patches; {} threads\n",
+         Mitsuba, relative error, mean over RGB; {} patches; {}; {} threads\n",
         scene.triangles.len(),
         if adaptive { "adaptive" } else { "uniform" },
+        format!("{:?} form factors, {} samples", ff.estimator, ff.samples),
         rayon::current_num_threads()
     );
     print!("| object | Mitsuba (rel. std. error) |");
@@ -69,7 +83,7 @@ fn main() {
         } else {
             Resolution::TargetPatches(target)
         };
-        let (light, patches) = room_light::object_light_with(&scene, resolution);
+        let (light, patches) = room_light::object_light_by(&scene, resolution, &ff);
         let seconds = t0.elapsed().as_secs_f64();
         let mut worst = (0f64, 0f64);
         for (row, o) in rows.iter_mut().zip(&objects) {

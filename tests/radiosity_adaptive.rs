@@ -127,8 +127,12 @@ fn adaptive_patches_are_the_same_for_any_thread_count() {
 }
 
 /// Per-object irradiance against Mitsuba 3 on the door-ajar scene at 4,000 patches: the
-/// uniform grid and adaptive patches side by side (the full curve: `ADAPTIVE=1 cargo bench
-/// --bench rooms_mitsuba`).
+/// uniform grid and adaptive patches side by side (the full curve: `relume-bake study radiosity
+/// --scene scenes/generated/door-ajar.obj --objects-reference tests/reference/door-ajar.mitsuba.json
+/// --sweeps objects`). Adaptive's worst channel is below the uniform grid's (measured 5.3 % vs
+/// 9.4 %), and adaptive brings every object within 5 % (mean over RGB, issue 19's bar; measured
+/// worst 4.88 %, the dark cabinet; the uniform grid misses it on 2 of 11 objects, worst 8.2 %).
+/// The bake is seeded and thread-count independent, so the figure reproduces exactly.
 #[test]
 fn adaptive_patches_come_closer_to_mitsuba_on_the_door_ajar() {
     let reference: Value = serde_json::from_str(
@@ -136,21 +140,58 @@ fn adaptive_patches_come_closer_to_mitsuba_on_the_door_ajar() {
     )
     .unwrap();
     let scene = room_light::room("door-ajar");
+    // (worst channel, worst object's mean over RGB, patches)
     let worst = |resolution| {
         let (light, n) = room_light::object_light_with(&scene, resolution);
-        let mut worst: f64 = 0.0;
+        let (mut channel, mut object): (f64, f64) = (0.0, 0.0);
         for (name, r) in reference.as_object().unwrap() {
             let got = light.iter().find(|l| &l.name == name).unwrap();
             let err = room_light::relative_error(got.irradiance_patches, r);
-            worst = err.iter().fold(worst, |w, e| w.max(e.abs()));
+            channel = err.iter().fold(channel, |w, e| w.max(e.abs()));
+            object = object.max((err.iter().sum::<f64>() / 3.0).abs());
         }
-        (worst, n)
+        (channel, object, n)
     };
-    let (uniform, nu) = worst(Resolution::TargetPatches(4000));
-    let (adaptive, na) = worst(Resolution::Adaptive(AdaptiveParams::new(4000)));
-    eprintln!("worst object: uniform {uniform:.4} ({nu} patches), adaptive {adaptive:.4} ({na})");
+    let (uniform, uniform_object, nu) = worst(Resolution::TargetPatches(4000));
+    let (adaptive, adaptive_object, na) = worst(Resolution::Adaptive(AdaptiveParams::new(4000)));
+    eprintln!(
+        "worst channel / object: uniform {uniform:.4} / {uniform_object:.4} ({nu} patches), \
+         adaptive {adaptive:.4} / {adaptive_object:.4} ({na})"
+    );
     assert!(
         adaptive < uniform,
         "adaptive {adaptive} vs uniform {uniform}"
     );
+    assert!(
+        adaptive_object <= 0.05,
+        "adaptive: an object is {adaptive_object} off Mitsuba"
+    );
+}
+
+/// The furnished room (78,324 triangles) at 2,000 adaptive patches against Mitsuba 3
+/// (tests/reference/furnished-room.mitsuba.json, 4 × 1 M samples per object, relative standard
+/// error ≤ 0.84 %): every object covering at least 0.5 % of the area (15 of 20) is within 5 %,
+/// mean over RGB (measured worst 4.29 %, the bookshelf; mean 1.1 %; the uniform grid at 2,000:
+/// 4.80 %, mean 2.0 %). Seeded and thread-count independent: the figure reproduces exactly.
+#[test]
+fn adaptive_patches_match_mitsuba_on_the_furnished_room() {
+    use relume::study::radiosity_objects::{measured_objects, read_reference};
+    let path = data("tests/reference/furnished-room.mitsuba.json");
+    let reference = read_reference(&path).unwrap();
+    let scene = room_light::room("furnished-room");
+    let (measured, _) = measured_objects(&scene, &reference, 0.005, &path).unwrap();
+    assert_eq!(measured.len(), 15, "{measured:?}");
+    let (light, n) =
+        room_light::object_light_with(&scene, Resolution::Adaptive(AdaptiveParams::new(2000)));
+    assert!((1600..=2400).contains(&n), "{n} patches");
+    for name in &measured {
+        let got = light.iter().find(|l| &l.name == name).unwrap();
+        let r = &reference[name];
+        let err = (0..3)
+            .map(|c| got.irradiance_patches[c] / r.mean[c] - 1.0)
+            .sum::<f64>()
+            / 3.0;
+        eprintln!("{name}: {:+.2} %", 100.0 * err);
+        assert!(err.abs() <= 0.05, "{name}: {err} off Mitsuba");
+    }
 }

@@ -30,6 +30,23 @@ pub fn object_light_at(scene: &Scene, target: u32) -> (Vec<ObjectLight>, usize) 
 
 /// [`object_light_at`] with any voxel resolution (e.g. adaptive patches).
 pub fn object_light_with(scene: &Scene, resolution: Resolution) -> (Vec<ObjectLight>, usize) {
+    object_light_by(
+        scene,
+        resolution,
+        &FormFactorParams {
+            estimator: Estimator::HemisphereReciprocal,
+            samples: 4096,
+            seed: 0,
+        },
+    )
+}
+
+/// [`object_light_with`] with any form-factor estimator.
+pub fn object_light_by(
+    scene: &Scene,
+    resolution: Resolution,
+    ff: &FormFactorParams,
+) -> (Vec<ObjectLight>, usize) {
     let set = voxelize(
         scene,
         &VoxelizeParams {
@@ -38,17 +55,7 @@ pub fn object_light_with(scene: &Scene, resolution: Resolution) -> (Vec<ObjectLi
         },
     )
     .unwrap();
-    let f = form_factors(
-        scene,
-        &set,
-        &FormFactorParams {
-            estimator: Estimator::HemisphereReciprocal,
-            samples: 4096,
-            seed: 0,
-        },
-        &Silent,
-    )
-    .unwrap();
+    let f = form_factors(scene, &set, ff, &Silent).unwrap();
     let albedo: Vec<[f32; 3]> = set.patches.iter().map(|p| p.albedo).collect();
     let s = transport(
         &f.values,
