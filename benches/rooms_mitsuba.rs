@@ -50,10 +50,12 @@ fn main() {
     let objects: Vec<&String> = reference.as_object().unwrap().keys().collect();
     println!(
         "{name}: {} triangles; relume per-object irradiance (patches | corner-interpolated) vs \
-         Mitsuba, relative error, mean over RGB; {} patches; {}; {} threads\n",
+         Mitsuba, relative error, mean over RGB; {} patches; {:?} form factors, {} samples; {} \
+         threads\n",
         scene.triangles.len(),
         if adaptive { "adaptive" } else { "uniform" },
-        format!("{:?} form factors, {} samples", ff.estimator, ff.samples),
+        ff.estimator,
+        ff.samples,
         rayon::current_num_threads()
     );
     print!("| object | Mitsuba (rel. std. error) |");
