@@ -8,7 +8,7 @@
 //! ([`crate::compress::report::standard_lights`]), bytes, encode time and the CPU gather time
 //! as a ratio to the dense mat-vec of the same run.
 
-use super::radiosity::{bake_scene, emitted_exitance};
+use super::scene_bake::{bake_scene, emitted_exitance};
 use super::timing::{median_secs, timed};
 use super::{relative, Column, ErrorStats, Format, Measure, Setting, Sweep};
 use crate::compress::report::{entry_errors, rms_relative, standard_lights};

@@ -24,6 +24,7 @@ pub mod plot;
 pub mod radiosity;
 pub mod radiosity_objects;
 pub mod report;
+pub mod scene_bake;
 pub mod soft_shadows;
 pub mod terrain;
 pub mod timing;

@@ -16,7 +16,7 @@
 //! listed in the notes). Errors are stats over the measured objects, each weighing 1: `max` is
 //! the worst object, `mean` the mean absolute error.
 
-use super::radiosity::{bake_scene, emitted_exitance, gathered};
+use super::scene_bake::{bake_scene, emitted_exitance, gathered};
 use super::{Column, ErrorStats, Format, Measure, Setting, Sweep};
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::{FormFactorsKnobs, VoxelizeKnobs};
