@@ -191,11 +191,10 @@ fn corner_weights(p: DVec3, n: DVec3, centre: DVec3, t: &PointTransfer) -> Vec<(
             if w <= 0.0 {
                 continue;
             }
-            let (_, q) = locator.distance(p, j);
+            let (_, q, qn) = locator.nearest(p, j);
             if n.dot(q - p).abs() > PLANE_DISTANCE {
                 continue;
             }
-            let qn = locator.piece_normal_near(j, q);
             let to = q + qn * lift + (p - q).try_normalize().unwrap_or(DVec3::ZERO) * lift;
             if vis.occluded(from, to) {
                 continue;

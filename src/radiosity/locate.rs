@@ -27,12 +27,19 @@ pub struct PatchLocator {
     /// A bounding sphere (centre, radius) of each piece: `distance` skips a piece that cannot
     /// come nearer than the best so far (a patch of a finely meshed statue holds hundreds).
     spheres: Vec<(DVec3, f64)>,
+    /// A sphere holding the spheres of each run of [`CHUNK`] consecutive pieces of a patch;
+    /// patch i's runs start at `chunk_first[i]`.
+    chunks: Vec<(DVec3, f64)>,
+    chunk_first: Vec<usize>,
     /// Dominant axis of each scene triangle.
     triangle_axis: Vec<u8>,
     /// Dense (first patch, count) per group key when the grid is small enough, else empty (then
     /// a binary search over `keys`).
     table: Vec<(u32, u32)>,
 }
+
+/// Pieces per bounding run in the nearest-piece search.
+const CHUNK: usize = 16;
 
 /// Largest grid (voxels × 8 axis slots) that gets a dense lookup table.
 const DENSE_TABLE: u64 = 1 << 24;
@@ -44,7 +51,7 @@ impl PatchLocator {
             .iter()
             .map(|p| group_key(p.voxel, p.axis, set.dims))
             .collect();
-        let ranges = set
+        let ranges: Vec<(usize, usize)> = set
             .patches
             .iter()
             .map(|p| (p.first_piece as usize, p.piece_count as usize))
@@ -59,7 +66,7 @@ impl PatchLocator {
                 )
             })
             .collect();
-        let spheres = pieces
+        let spheres: Vec<(DVec3, f64)> = pieces
             .iter()
             .map(|(poly, _)| {
                 let c = poly.iter().sum::<DVec3>() / poly.len().max(1) as f64;
@@ -67,6 +74,19 @@ impl PatchLocator {
                 (c, r)
             })
             .collect();
+        let (mut chunks, mut chunk_first) = (Vec::new(), Vec::with_capacity(set.patches.len()));
+        for &(first, count) in &ranges {
+            chunk_first.push(chunks.len());
+            for run in spheres[first..first + count].chunks(CHUNK) {
+                let c = run.iter().map(|s| s.0).sum::<DVec3>() / run.len() as f64;
+                // Rounded up a little, so no piece's sphere pokes out by rounding.
+                let r = run
+                    .iter()
+                    .map(|s| (s.0 - c).length() + s.1)
+                    .fold(0.0, f64::max);
+                chunks.push((c, r * (1.0 + 1e-12) + 1e-12));
+            }
+        }
         let triangle_axis = (0..scene.triangles.len())
             .map(|t| {
                 let [a, b, c] = scene.corners(t).map(|v| v.as_dvec3());
@@ -91,6 +111,8 @@ impl PatchLocator {
             ranges,
             pieces,
             spheres,
+            chunks,
+            chunk_first,
             triangle_axis,
             table,
         }
@@ -116,40 +138,52 @@ impl PatchLocator {
         lo..hi
     }
 
-    /// Distance from `p` to patch `i`'s pieces and the closest point on them.
-    pub fn distance(&self, p: DVec3, i: usize) -> (f64, DVec3) {
-        let (d, q, _) = self.nearest_piece(p, i, f64::INFINITY);
-        (d, q)
-    }
-
     /// The first of patch `i`'s pieces nearest to `p` — (distance, closest point, piece) — or
     /// (∞, p, 0) when none comes within `bound`. A piece whose bounding sphere lies farther than
     /// the best so far is skipped: no point of it is nearer than |p − c| − r, and the margin
     /// (1e-9 grid units, far above the rounding of either side) keeps every piece that could
     /// tie or win, so the answer is the one a full scan gives.
+    ///
+    /// Pieces are also bounded in runs of [`CHUNK`] (a sphere holding the run's spheres), and
+    /// the run nearest to `p` is searched first so the best tightens at once. Runs are visited
+    /// out of order, so a tie is settled by the lower piece index, as the in-order scan does.
     fn nearest_piece(&self, p: DVec3, i: usize, bound: f64) -> (f64, DVec3, usize) {
         let (first, count) = self.ranges[i];
-        let mut best = (f64::INFINITY, p, 0);
-        for k in first..first + count {
-            let (c, r) = self.spheres[k];
-            if (p - c).length() - r > best.0.min(bound) + 1e-9 {
+        let chunks = &self.chunks[self.chunk_first[i]..self.chunk_first[i] + count.div_ceil(CHUNK)];
+        let lower = |&(c, r): &(DVec3, f64)| (p - c).length() - r;
+        let start = (0..chunks.len())
+            .min_by(|&a, &b| lower(&chunks[a]).total_cmp(&lower(&chunks[b])))
+            .unwrap_or(0);
+        let mut best = (f64::INFINITY, p, usize::MAX);
+        for run in std::iter::once(start).chain((0..chunks.len()).filter(|&r| r != start)) {
+            if lower(&chunks[run]) > best.0.min(bound) + 1e-9 {
                 continue;
             }
-            let (poly, n) = &self.pieces[k];
-            let q = geometry::closest_point_on_polygon(p, poly, *n);
-            let d = (q - p).length();
-            if d < best.0 {
-                best = (d, q, k);
+            let lo = first + run * CHUNK;
+            for k in lo..(lo + CHUNK).min(first + count) {
+                if lower(&self.spheres[k]) > best.0.min(bound) + 1e-9 {
+                    continue;
+                }
+                let (poly, n) = &self.pieces[k];
+                let q = geometry::closest_point_on_polygon(p, poly, *n);
+                let d = (q - p).length();
+                if d < best.0 || (d == best.0 && k < best.2) {
+                    best = (d, q, k);
+                }
             }
+        }
+        if best.2 == usize::MAX {
+            best.2 = 0;
         }
         best
     }
 
-    /// The unit normal of patch `i`'s piece nearest to `p`.
-    pub fn piece_normal_near(&self, i: usize, p: DVec3) -> DVec3 {
+    /// Distance from `p` to patch `i`'s pieces, the closest point on them and the unit normal
+    /// of the piece it lies on.
+    pub fn nearest(&self, p: DVec3, i: usize) -> (f64, DVec3, DVec3) {
         match self.nearest_piece(p, i, f64::INFINITY) {
-            (d, _, k) if d.is_finite() => self.pieces[k].1,
-            _ => DVec3::Z,
+            (d, q, k) if d.is_finite() => (d, q, self.pieces[k].1),
+            (d, q, _) => (d, q, DVec3::Z),
         }
     }
 
@@ -211,4 +245,53 @@ impl PatchLocator {
 /// The voxel containing `p` (clamped into the grid).
 pub fn voxel_of(p: DVec3, dims: [u32; 3]) -> [i64; 3] {
     std::array::from_fn(|a| (p[a].floor() as i64).clamp(0, dims[a] as i64 - 1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::radiosity::fixtures;
+    use crate::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+    use proptest::prelude::*;
+
+    /// Two 300-gon discs in voxels as large as the scene: each patch holds hundreds of pieces,
+    /// so the nearest-piece search prunes whole runs.
+    fn disc_set() -> (Scene, PatchSet) {
+        let scene = fixtures::coaxial_discs(1.0, 0.7, 0.5, 300);
+        let set = voxelize(
+            &scene,
+            &VoxelizeParams {
+                resolution: Resolution::VoxelSize(0.8),
+                samples_per_patch: 1,
+            },
+        )
+        .unwrap();
+        (scene, set)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// The pruned search equals a full scan of the patch's pieces: the same distance, point
+        /// and normal (the first piece among equals), for points near and far.
+        #[test]
+        fn nearest_equals_a_full_scan(x in -3.0f64..3.0, y in -2.0f64..2.0, z in -3.0f64..3.0) {
+            let (scene, set) = disc_set();
+            let loc = PatchLocator::new(&set, &scene);
+            prop_assert!(set.patches.iter().any(|p| p.piece_count as usize > 4 * CHUNK));
+            let p = DVec3::new(x, y, z);
+            for (i, patch) in set.patches.iter().enumerate() {
+                let mut want = (f64::INFINITY, p, DVec3::Z);
+                for piece in set.patch_pieces(patch) {
+                    let poly: Vec<DVec3> = piece.vertices.iter().map(|&v| DVec3::from(v)).collect();
+                    let n = DVec3::from(piece.normal);
+                    let q = geometry::closest_point_on_polygon(p, &poly, n);
+                    let d = (q - p).length();
+                    if d < want.0 {
+                        want = (d, q, n);
+                    }
+                }
+                prop_assert_eq!(loc.nearest(p, i), want);
+            }
+        }
+    }
 }
