@@ -9,10 +9,13 @@
 //! and `tests/reference/cornell.mitsuba.json` from
 //! `RELUME_EMITTER_DROP=0.1 python3 tests/support/mitsuba_objects.py scenes/cornell-box/cornell_box.obj 1000000 4`
 //! (the light lowered 0.1 mm out of the ceiling's plane; Mitsuba's ceiling then includes the
-//! 4.4 % of its area hidden above the light, which relume cuts away).
+//! 4.4 % of its area hidden above the light, which relume cuts away), and
+//! `tests/reference/furnished-room.mitsuba.json` from
+//! `python3 tests/support/mitsuba_objects.py scenes/generated/furnished-room.obj 1000000 4`
+//! (14 min on 2 cores).
 //!
 //! Run: `cargo bench --bench rooms_mitsuba` (`PATCHES=1000,2000,4000,8000`,
-//! `SCENE=door-ajar|cornell`, `ADAPTIVE=1` for `Resolution::Adaptive` instead of
+//! `SCENE=door-ajar|cornell|furnished-room`, `ADAPTIVE=1` for `Resolution::Adaptive` instead of
 //! `TargetPatches`, `BASE_SHARE=0.5` its base grid's share of the target, `ESTIMATOR=hemisphere|
 //! pairwise` and `SAMPLES=n` for another form-factor estimator than the default reciprocal
 //! hemisphere with 4,096 rays).

@@ -78,21 +78,29 @@ pub(super) fn clip_pieces(
 
 /// Split each group of `pieces` (sorted by key) into clusters that see each other
 /// ([`split_visible`]). One cluster is one patch.
+/// Groups are clustered in parallel and concatenated in key order: the same output for any
+/// thread count.
 pub(super) fn clusters(pieces: &[(u64, Piece)], vis: &Visibility) -> Vec<(u64, Vec<usize>)> {
-    let mut out = Vec::new();
+    use rayon::prelude::*;
+    let mut groups = Vec::new();
     let mut start = 0;
     while start < pieces.len() {
         let key = pieces[start].0;
         let end = start + pieces[start..].iter().take_while(|p| p.0 == key).count();
-        let members: Vec<usize> = (start..end).collect();
-        out.extend(
-            split_visible(&members, pieces, vis)
-                .into_iter()
-                .map(|m| (key, m)),
-        );
+        groups.push((key, start..end));
         start = end;
     }
-    out
+    let split: Vec<Vec<(u64, Vec<usize>)>> = groups
+        .into_par_iter()
+        .map(|(key, range)| {
+            let members: Vec<usize> = range.collect();
+            split_visible(&members, pieces, vis)
+                .into_iter()
+                .map(|m| (key, m))
+                .collect()
+        })
+        .collect();
+    split.into_iter().flatten().collect()
 }
 
 /// Split `members` (indices into `pieces`) into clusters that see each other: a piece joins
