@@ -129,6 +129,12 @@ docs-images: build
 	$(BAKE) -q study terrain --sizes 512,1024,2048 --elevations 5,30 --soft-elevations 2,5 \
 	    --soft-rows 64 --out $(DOCS_OUT)/study/terrain
 	$(BAKE) -q study atmosphere --paths 40000 --out $(DOCS_OUT)/study/atmosphere
+	for s in door-ajar furnished-room; do \
+	    $(BAKE) -q study radiosity --scene scenes/generated/$$s.obj --sweeps objects \
+	        --objects-reference tests/reference/$$s.mitsuba.json --out $(DOCS_OUT)/study/objects-$$s || exit 1; \
+	    cp $(DOCS_OUT)/study/objects-$$s/radiosity_objects_error_vs_patches.png \
+	        docs/images/study-objects-$$s.png || exit 1; \
+	done
 	cp $(DOCS_OUT)/study/atmosphere/atmosphere_error_vs_elevation.png \
 	    docs/images/study-atmosphere-error-vs-elevation.png
 	for f in radiosity/radiosity_patches_error_vs_time radiosity/radiosity_estimator_error_vs_time \

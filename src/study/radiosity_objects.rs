@@ -317,11 +317,11 @@ pub fn objects_sweep(
         x: Measure::extra("patches"),
         y: Measure::error("object_irradiance", "max"),
         x_label: "patches".into(),
-        y_label: "worst object's irradiance error (relative)".into(),
+        y_label: "worst object, irradiance error (relative)".into(),
     });
     sweep.error_plots(
         Measure::error("object_irradiance", "max"),
-        "worst object's irradiance error (relative)",
+        "worst object, irradiance error (relative)",
     );
     Ok(sweep)
 }
