@@ -38,7 +38,8 @@ fn main() {
     let estimator = match util::env("ESTIMATOR", "reciprocal".to_string()).as_str() {
         "hemisphere" => Estimator::Hemisphere,
         "pairwise" => Estimator::Pairwise,
-        _ => Estimator::HemisphereReciprocal,
+        "reciprocal" => Estimator::HemisphereReciprocal,
+        other => panic!("ESTIMATOR={other}: expected reciprocal, hemisphere or pairwise"),
     };
     let ff = FormFactorParams {
         estimator,

@@ -24,8 +24,9 @@ pub struct PatchLocator {
     ranges: Vec<(usize, usize)>,
     /// Vertices and unit normal of each piece.
     pieces: Vec<(Vec<DVec3>, DVec3)>,
-    /// A bounding sphere (centre, radius) of each piece: `distance` skips a piece that cannot
-    /// come nearer than the best so far (a patch of a finely meshed statue holds hundreds).
+    /// A bounding sphere (centre, radius) of each piece: the nearest-piece search skips a piece
+    /// that cannot come nearer than the best so far (a patch of a finely meshed statue holds
+    /// hundreds).
     spheres: Vec<(DVec3, f64)>,
     /// A sphere holding the spheres of each run of [`CHUNK`] consecutive pieces of a patch;
     /// patch i's runs start at `chunk_first[i]`.
