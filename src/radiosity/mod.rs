@@ -33,6 +33,8 @@ pub mod transport_shard;
 pub mod visibility;
 pub mod voxel_size;
 pub mod voxelize;
+pub mod watertight;
+pub mod wide_bvh;
 
 pub use matrix::TransportMatrix;
 use serde::{Deserialize, Serialize};

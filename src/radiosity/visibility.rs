@@ -1,42 +1,42 @@
-//! Ray visibility through an obvhs compressed-wide BVH over the scene's triangles, in grid
-//! coordinates (f32). Two queries: the closest hit (hemisphere shooting) and occlusion of a
-//! segment (pairwise form factors, patch clustering, the transfer's leak test).
+//! Ray visibility through an 8-wide BVH over the scene's triangles, in grid coordinates (f32).
+//! Two queries: the closest hit (hemisphere shooting) and occlusion of a segment (pairwise form
+//! factors, patch clustering, the transfer's leak test).
 //!
+//! obvhs builds the tree (a compressed-wide BVH, its highest-quality preset); [`WideBvh`] keeps
+//! its shape with exact f32 child boxes and traverses it with AVX2 slab tests (wide_bvh.rs).
 //! Triangles are tested with a watertight intersection (no rays lost through shared edges).
-//! Rays start slightly behind their origin to dodge obvhs's absolute 1e-4 near-hit cut-off.
-//! Occlusion uses `CwBvh::ray_traverse_miss`, which stops at the first hit below `tmax`;
-//! `ray_traverse_anyhit` is *not* an occlusion test (it visits every hit) — see docs/dependencies.md.
+//! Rays start `BACKOFF` behind their origin (see there). The closest hit is order-independent:
+//! of two hits at the same distance (a shared edge) the lower leaf slot wins.
 
 use super::geometry::Frame;
+use super::watertight::{TriangleLanes, Watertight};
+use super::wide_bvh::{BoxRay, ClosestLeaf, WideBvh};
 use crate::scene::Scene;
 use glam::{DVec3, Vec3A};
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
-use obvhs::cwbvh::CwBvh;
-use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 use std::time::Duration;
 
 /// The scene's non-degenerate triangles in a BVH.
 pub struct Visibility {
-    bvh: CwBvh,
+    bvh: WideBvh,
     tris: Vec<Triangle>,
     /// Scene triangle index of each BVH triangle.
     ids: Vec<u32>,
-    /// Unit geometric normal (from the counter-clockwise winding) of each BVH triangle.
-    normals: Vec<Vec3A>,
     /// The triangle of every BVH primitive slot, in leaf order (a triangle split into several
     /// boxes appears once per box): a leaf's triangles are contiguous in memory and reached
     /// without the `primitive_indices` indirection.
     slots: Vec<Slot>,
+    /// The slots' triangles by component, for four-at-a-time leaf tests.
+    lanes: TriangleLanes,
     /// Smallest ray parameter accepted, in grid units (above f32 self-intersection noise).
     pub epsilon: f32,
 }
 
-/// obvhs's CWBVH node test clamps the entry distance to an absolute 1e-4 (`cwbvh::node::EPSILON`),
-/// so a hit closer than that to the ray's start is lost — a ray leaving a floor point 1e-5 from a
-/// wall would escape through the wall. Rays therefore start `BACKOFF` behind their origin and only
-/// hits at or beyond `BACKOFF` count.
+/// Rays start `BACKOFF` behind their origin and only hits at or beyond `BACKOFF` count. (obvhs's
+/// own CWBVH traversal, used until the wide BVH replaced it, clamps entry distances to an absolute
+/// 1e-4 and lost nearer hits; the offset stays so that every distance is the one it measured.)
 pub const BACKOFF: f32 = 2.5e-4;
 
 /// The closest surface a ray hits.
@@ -75,7 +75,7 @@ impl Visibility {
             BvhBuildParams::very_slow_build(),
             &mut Duration::default(),
         );
-        let slots = bvh
+        let slots: Vec<Slot> = bvh
             .primitive_indices
             .iter()
             .map(|&k| {
@@ -87,11 +87,19 @@ impl Visibility {
                 }
             })
             .collect();
+        let bvh = WideBvh::from_cwbvh(&bvh, |i| {
+            let v: &[Vec3A; 3] = &slots[i].v;
+            (
+                v[0].min(v[1]).min(v[2]).to_array(),
+                v[0].max(v[1]).max(v[2]).to_array(),
+            )
+        });
+        let lanes = TriangleLanes::new(&slots.iter().map(|s| s.v).collect::<Vec<_>>());
         Visibility {
             bvh,
+            lanes,
             tris,
             ids: triangles.to_vec(),
-            normals,
             slots,
             epsilon: ray_epsilon(extent),
         }
@@ -126,50 +134,58 @@ impl Visibility {
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
         let start = origin - dir * BACKOFF as f64;
         let wt = Watertight::new(start, dir);
-        let ray = Ray::new(
-            Vec3A::from(start.as_vec3()),
-            Vec3A::from(dir.as_vec3()),
-            0.0,
-            f32::INFINITY,
-        );
-        let mut hit = RayHit::none();
-        let d = ray.direction;
-        let found = self.bvh.ray_traverse(ray, &mut hit, |r, id| {
-            self.slot_distance(&wt, &self.slots[id], d, BACKOFF, r.tmax)
-        });
-        if !found {
-            return None;
-        }
-        let slot = &self.slots[hit.primitive_id as usize];
+        let d = Vec3A::from(dir.as_vec3());
+        let ray = BoxRay::new(start.as_vec3().to_array(), d.to_array());
+        let mut leaf = Closest {
+            vis: self,
+            wt: &wt,
+            d,
+            best: u32::MAX,
+        };
+        let t = self.bvh.closest(&ray, BACKOFF, f32::INFINITY, &mut leaf);
+        let slot = self.slots.get(leaf.best as usize)?;
         Some(Hit {
             triangle: self.ids[slot.k as usize],
-            t: hit.t - BACKOFF,
+            t: t - BACKOFF,
             front: slot.normal.dot(d) < 0.0,
         })
     }
 
-    /// [`Visibility::closest_hit`] by testing every triangle (for tests of the BVH path).
+    /// [`Visibility::closest_hit`] by testing every triangle slot in order with the scalar test:
+    /// the same answer bit for bit (tests/radiosity_visibility.rs), without the tree.
     pub fn closest_hit_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let wt = Watertight::new(origin, dir);
+        let start = origin - dir * BACKOFF as f64;
+        let wt = Watertight::new(start, dir);
         let d = Vec3A::from(dir.as_vec3());
-        let mut best: Option<Hit> = None;
-        for k in 0..self.tris.len() {
-            let t = &self.tris[k];
-            let slot = Slot {
-                v: [t.v0, t.v1, t.v2],
-                normal: self.normals[k],
-                k: k as u32,
-            };
-            let t = self.slot_distance(&wt, &slot, d, 0.0, best.map_or(f32::INFINITY, |b| b.t));
-            if t.is_finite() && best.is_none_or(|b| t < b.t) {
-                best = Some(Hit {
-                    triangle: self.ids[k],
-                    t,
-                    front: self.normals[k].dot(d) < 0.0,
-                });
+        let mut best: Option<(f32, &Slot)> = None;
+        for slot in &self.slots {
+            let tmax = best.map_or(f32::INFINITY, |b| b.0);
+            let t = self.slot_distance(&wt, slot, d, BACKOFF, tmax);
+            if t < tmax {
+                best = Some((t, slot));
             }
         }
-        best
+        best.map(|(t, slot)| Hit {
+            triangle: self.ids[slot.k as usize],
+            t: t - BACKOFF,
+            front: slot.normal.dot(d) < 0.0,
+        })
+    }
+
+    /// [`Visibility::occluded`] by testing every triangle slot with the scalar test.
+    pub fn occluded_brute_force(&self, from: DVec3, to: DVec3) -> bool {
+        let delta = to - from;
+        let len = delta.length();
+        if len <= 0.0 {
+            return false;
+        }
+        let dir = delta / len;
+        let wt = Watertight::new(from - dir * BACKOFF as f64, dir);
+        let d = Vec3A::from(dir.as_vec3());
+        let tmax = len as f32 + BACKOFF;
+        self.slots
+            .iter()
+            .any(|slot| self.slot_distance(&wt, slot, d, BACKOFF, tmax).is_finite())
     }
 
     /// Distance along the ray of `wt` (which starts `start` before the caller's origin) to the
@@ -187,6 +203,13 @@ impl Visibility {
         }
     }
 
+    /// Whether a finite distance `t` of the watertight test to slot `s` stops the ray: the rule
+    /// of [`Visibility::slot_distance`].
+    #[inline(always)]
+    fn counts(&self, s: u32, t: f32, d: Vec3A) -> bool {
+        t.is_finite() && (t - BACKOFF >= self.epsilon || self.slots[s as usize].normal.dot(d) < 0.0)
+    }
+
     /// True when a surface lies on the segment from `from` to `to` (both lifted off their
     /// surfaces by the caller).
     pub fn occluded(&self, from: DVec3, to: DVec3) -> bool {
@@ -198,16 +221,45 @@ impl Visibility {
         let dir = delta / len;
         let start = from - dir * BACKOFF as f64;
         let wt = Watertight::new(start, dir);
-        let ray = Ray::new(
-            Vec3A::from(start.as_vec3()),
-            Vec3A::from(dir.as_vec3()),
-            0.0,
-            len as f32 + BACKOFF,
-        );
-        let d = ray.direction;
-        !self.bvh.ray_traverse_miss(ray, |r, id| {
-            self.slot_distance(&wt, &self.slots[id], d, BACKOFF, r.tmax)
+        let d = Vec3A::from(dir.as_vec3());
+        let ray = BoxRay::new(start.as_vec3().to_array(), d.to_array());
+        let tmax = len as f32 + BACKOFF;
+        self.bvh.any(&ray, BACKOFF, tmax, |first, count| {
+            let ts = self
+                .lanes
+                .intersect4(&wt, first as usize, count as usize, BACKOFF, tmax);
+            (0..count as usize).any(|k| self.counts(first + k as u32, ts[k], d))
         })
+    }
+}
+
+/// The closest-hit leaf test: the watertight distance to each slot's triangle; of equal
+/// distances the lower slot wins, so the answer does not depend on the traversal order.
+struct Closest<'a> {
+    vis: &'a Visibility,
+    wt: &'a Watertight,
+    d: Vec3A,
+    best: u32,
+}
+
+impl ClosestLeaf for Closest<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, mut tmax: f32) -> f32 {
+        let ts = self
+            .vis
+            .lanes
+            .intersect4(self.wt, first as usize, count as usize, BACKOFF, tmax);
+        for (k, &t) in ts.iter().enumerate().take(count as usize) {
+            let s = first + k as u32;
+            if !self.vis.counts(s, t, self.d) {
+                continue;
+            }
+            if t < tmax || (t == tmax && s < self.best) {
+                tmax = t;
+                self.best = s;
+            }
+        }
+        tmax
     }
 }
 
@@ -217,86 +269,6 @@ struct Slot {
     v: [Vec3A; 3],
     normal: Vec3A,
     k: u32,
-}
-
-/// Watertight ray/triangle intersection (Woop, Benthin and Wald, JCGT 2013): a ray through the
-/// shared edge or vertex of two triangles hits at least one of them, so closed scenes do not leak
-/// rays through their seams (obvhs's Möller–Trumbore test does).
-///
-/// The paper's shear `(a[kx] − sx·a[kz], a[ky] − sy·a[kz], sz·a[kz])` of a vertex a (relative to
-/// the origin) is taken as three dot products with rows holding 1, −s and 0 in the permuted
-/// axes: each product by 1 or 0 is exact and adding an exact 0 changes nothing, so every value
-/// is the paper's bit for bit (no FMA contraction in Rust), without indexing by kx, ky, kz.
-struct Watertight {
-    origin: Vec3A,
-    rows: [Vec3A; 3],
-}
-
-impl Watertight {
-    fn new(origin: DVec3, dir: DVec3) -> Self {
-        let d = dir.as_vec3();
-        let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let row = |k: usize, kz_weight: f32| {
-            let mut r = [0.0f32; 3];
-            r[k] = 1.0;
-            r[kz] = kz_weight;
-            Vec3A::from_array(r)
-        };
-        let sz = 1.0 / d[kz];
-        let mut z = [0.0f32; 3];
-        z[kz] = sz;
-        Watertight {
-            origin: Vec3A::from(origin.as_vec3()),
-            rows: [
-                row(kx, -(d[kx] / d[kz])),
-                row(ky, -(d[ky] / d[kz])),
-                Vec3A::from_array(z),
-            ],
-        }
-    }
-
-    /// Distance to the triangle, or infinity when missed or outside `[tmin, tmax]`.
-    #[inline]
-    fn intersect(&self, v: &[Vec3A; 3], tmin: f32, tmax: f32) -> f32 {
-        let [rx, ry, rz] = self.rows;
-        let shear = |p: Vec3A| {
-            let q = p - self.origin;
-            (q.dot(rx), q.dot(ry), q.dot(rz))
-        };
-        let ((ax, ay, az), (bx, by, bz), (cx, cy, cz)) = (shear(v[0]), shear(v[1]), shear(v[2]));
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            u = (cx as f64 * by as f64 - cy as f64 * bx as f64) as f32;
-            v = (ax as f64 * cy as f64 - ay as f64 * cx as f64) as f32;
-            w = (bx as f64 * ay as f64 - by as f64 * ax as f64) as f32;
-        }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-            return f32::INFINITY;
-        }
-        let det = u + v + w;
-        if det == 0.0 {
-            return f32::INFINITY;
-        }
-        let t = (u * az + v * bz + w * cz) / det;
-        if t >= tmin && t <= tmax {
-            t
-        } else {
-            f32::INFINITY
-        }
-    }
 }
 
 /// The ray epsilon for a grid whose largest coordinate is `extent`: a few hundred f32 ulps of the

@@ -1,0 +1,543 @@
+//! An 8-wide BVH with uncompressed f32 child boxes, traversed one ray at a time with all eight
+//! slab tests in one AVX2 pass (chosen at run time; a portable loop elsewhere).
+//!
+//! Why not obvhs's own traversal: its CWBVH node stores 8-bit child planes that every visit
+//! decodes, and it tests them four at a time with SSE2. On the rays of the form-factor stage
+//! that ran at 0.44–0.85x Embree per core (docs/radiosity.md); this layout (Embree's BVH8 idea:
+//! boxes stored as 6 × 8 floats, a child's entry distance from one subtract and one multiply
+//! per plane) is what `benches/visibility_embree.rs` measures against it.
+//!
+//! The tree's *shape* is obvhs's: [`WideBvh::from_cwbvh`] keeps every node, child slot and leaf
+//! of a [`CwBvh`] (its PLOC build and reinsertion optimiser make the tree quality that matters
+//! most, see docs/radiosity.md), and replaces the quantised child boxes by exact ones refitted
+//! from the primitives' own boxes.
+//!
+//! Preconditions: primitive boxes are finite. The traversal is conservative: a child box is
+//! entered whenever the exact ray meets it (Ize, "Robust BVH ray traversal", JCGT 2013: the
+//! far distance is scaled up by 1 + 2γ₃ to cover the rounding of `(b − o) · (1/d)`), so a leaf
+//! test that hits a primitive in exact arithmetic is always reached.
+
+use obvhs::cwbvh::CwBvh;
+
+/// A child reference: a node index, or a leaf (`LEAF` bit set) holding `count` (≤ 7) primitives
+/// from `first`: `LEAF | first << 3 | count`.
+const LEAF: u32 = 1 << 31;
+const EMPTY: u32 = u32::MAX;
+
+/// 1 + 2γ₃ with γₙ = n·u / (1 − n·u), u = 2⁻²⁴, rounded up (Ize 2013, eq. 14).
+const FAR_SCALE: f32 = 1.0 + 2.0 * (3.0 * 5.960_464_5e-8 / (1.0 - 3.0 * 5.960_464_5e-8)) * 1.0001;
+
+/// Eight children: their boxes as planes (min x, y, z, max x, y, z) × 8 lanes, and references.
+/// An empty slot has an inverted box (+∞ … −∞) that no ray enters.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+struct Node {
+    planes: [[f32; 8]; 6],
+    child: [u32; 8],
+}
+
+/// The tree. Primitive indices are positions in the `CwBvh`'s `primitive_indices` (leaf order).
+pub struct WideBvh {
+    nodes: Vec<Node>,
+    root: u32,
+    avx2: bool,
+    /// Boxes up to this far beyond `tmax` are still entered: a leaf test's distance is rounded
+    /// (the watertight test's by a few ulps of the largest coordinate, not of the distance), so
+    /// a box whose rounded entry lies just past a hit may hold a triangle whose rounded distance
+    /// ties or beats it. 2⁻¹⁸ of the largest coordinate magnitude: 64 of its ulps.
+    margin: f32,
+}
+
+/// A ray prepared for the slab tests: origin, reciprocal direction and the plane rows nearest
+/// the origin per axis.
+///
+/// A zero direction component gives an infinite reciprocal of the zero's sign (and the near row
+/// by that sign), so a slab the ray runs parallel to yields ±∞ from planes on either side of the
+/// origin and NaN (0 · ∞) from a plane through it; the min/max below keep the running bound when
+/// one operand is NaN, so such a plane constrains nothing — the exact answer for a ray lying in a
+/// box face.
+#[derive(Clone, Copy)]
+pub struct BoxRay {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    /// For each axis the plane row (0..6) a ray enters the slab through.
+    near: [usize; 3],
+}
+
+impl BoxRay {
+    pub fn new(origin: [f32; 3], dir: [f32; 3]) -> Self {
+        BoxRay {
+            origin,
+            inv: dir.map(|d| 1.0 / d),
+            near: std::array::from_fn(|k| if dir[k].is_sign_negative() { 3 + k } else { k }),
+        }
+    }
+}
+
+/// What a leaf test reports to a closest-hit traversal.
+pub trait ClosestLeaf {
+    /// Test the primitives `first..first + count` (closest hits below `tmax`) and return the new
+    /// `tmax` (unchanged when none is closer).
+    fn leaf(&mut self, first: u32, count: u32, tmax: f32) -> f32;
+}
+
+impl WideBvh {
+    /// The tree of `bvh`, with exact child boxes: `prim_box(i)` is the box of primitive slot `i`
+    /// (`bvh.primitive_indices[i]`'s primitive) as (min, max).
+    pub fn from_cwbvh(bvh: &CwBvh, prim_box: impl Fn(usize) -> ([f32; 3], [f32; 3])) -> Self {
+        let avx2 = detect_avx2();
+        if bvh.nodes.is_empty() || bvh.primitive_indices.is_empty() {
+            return WideBvh {
+                nodes: Vec::new(),
+                root: EMPTY,
+                avx2,
+                margin: 0.0,
+            };
+        }
+        let mut nodes = vec![
+            Node {
+                planes: [
+                    [f32::INFINITY; 8],
+                    [f32::INFINITY; 8],
+                    [f32::INFINITY; 8],
+                    [f32::NEG_INFINITY; 8],
+                    [f32::NEG_INFINITY; 8],
+                    [f32::NEG_INFINITY; 8]
+                ],
+                child: [EMPTY; 8],
+            };
+            bvh.nodes.len()
+        ];
+        let (lo, hi) = refit(bvh, 0, &prim_box, &mut nodes);
+        let largest = lo.iter().chain(&hi).fold(0.0f32, |m, x| m.max(x.abs()));
+        WideBvh {
+            nodes,
+            root: 0,
+            avx2,
+            margin: largest * (1.0 / (1 << 18) as f32),
+        }
+    }
+
+    /// The closest hit below `tmax`: every leaf whose box the ray meets before the current
+    /// closest distance (plus the rounding margin) is handed to `leaf`, nearest box first.
+    /// Returns the final `tmax`.
+    pub fn closest<L: ClosestLeaf>(&self, ray: &BoxRay, tmin: f32, tmax: f32, leaf: &mut L) -> f32 {
+        // Entry distances are ≥ tmin and sorted by their bits, which order like the floats
+        // only for positive values.
+        debug_assert!(tmin > 0.0);
+        if self.root == EMPTY {
+            return tmax;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: AVX2 and FMA were detected at run time.
+            return unsafe { self.closest_avx2(ray, tmin, tmax, leaf) };
+        }
+        self.closest_with(ray, tmin, tmax, leaf, node_hits_portable)
+    }
+
+    /// True when some leaf test reports a hit: `leaf(first, count)` is asked for every leaf whose
+    /// box the ray meets in `[tmin, tmax]`, in no particular order, until one says true.
+    pub fn any(
+        &self,
+        ray: &BoxRay,
+        tmin: f32,
+        tmax: f32,
+        leaf: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        if self.root == EMPTY {
+            return false;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: AVX2 and FMA were detected at run time.
+            return unsafe { self.any_avx2(ray, tmin, tmax, leaf) };
+        }
+        self.any_with(ray, tmin, tmax, leaf, node_hits_portable)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn closest_avx2<L: ClosestLeaf>(
+        &self,
+        ray: &BoxRay,
+        tmin: f32,
+        tmax: f32,
+        leaf: &mut L,
+    ) -> f32 {
+        self.closest_with(ray, tmin, tmax, leaf, |n, r, a, b, d| unsafe {
+            node_hits_avx2(n, r, a, b, d)
+        })
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn any_avx2(
+        &self,
+        ray: &BoxRay,
+        tmin: f32,
+        tmax: f32,
+        leaf: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        self.any_with(ray, tmin, tmax, leaf, |n, r, a, b, d| unsafe {
+            node_hits_avx2(n, r, a, b, d)
+        })
+    }
+
+    #[inline(always)]
+    fn closest_with<L: ClosestLeaf>(
+        &self,
+        ray: &BoxRay,
+        tmin: f32,
+        mut tmax: f32,
+        leaf: &mut L,
+        hits: impl Fn(&Node, &BoxRay, f32, f32, &mut [f32; 8]) -> u32,
+    ) -> f32 {
+        // Entries (entry distance bits << 32 | child): distances are ≥ tmin ≥ 0, so their bits
+        // order like the floats.
+        let mut stack = Stack::<u64>::new();
+        let mut current = self.root;
+        let mut dist = [0.0f32; 8];
+        loop {
+            if current & LEAF != 0 {
+                tmax = leaf.leaf((current & !LEAF) >> 3, current & 7, tmax);
+            } else {
+                let node = &self.nodes[current as usize];
+                let mut mask = hits(node, ray, tmin, tmax + self.margin, &mut dist);
+                if mask != 0 {
+                    let k = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if mask == 0 {
+                        current = node.child[k];
+                        continue;
+                    }
+                    // Push every hit child, then sort this group so that the nearest is on top.
+                    let base = stack.len();
+                    stack.push((dist[k].to_bits() as u64) << 32 | node.child[k] as u64);
+                    while mask != 0 {
+                        let k = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack.insert_descending(
+                            base,
+                            (dist[k].to_bits() as u64) << 32 | node.child[k] as u64,
+                        );
+                    }
+                }
+            }
+            // Pop the nearest entry still in front of the closest hit.
+            loop {
+                let Some(e) = stack.pop() else {
+                    return tmax;
+                };
+                if f32::from_bits((e >> 32) as u32) <= tmax + self.margin {
+                    current = e as u32;
+                    break;
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn any_with(
+        &self,
+        ray: &BoxRay,
+        tmin: f32,
+        tmax: f32,
+        mut leaf: impl FnMut(u32, u32) -> bool,
+        hits: impl Fn(&Node, &BoxRay, f32, f32, &mut [f32; 8]) -> u32,
+    ) -> bool {
+        let mut stack = Stack::<u32>::new();
+        let mut current = self.root;
+        let mut dist = [0.0f32; 8];
+        loop {
+            if current & LEAF != 0 {
+                if leaf((current & !LEAF) >> 3, current & 7) {
+                    return true;
+                }
+            } else {
+                let node = &self.nodes[current as usize];
+                let mut mask = hits(node, ray, tmin, tmax + self.margin, &mut dist);
+                while mask != 0 {
+                    let k = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack.push(node.child[k]);
+                }
+            }
+            match stack.pop() {
+                Some(c) => current = c,
+                None => return false,
+            }
+        }
+    }
+}
+
+/// Deep enough for any tree obvhs builds: each level pushes at most 7 entries, and a tree of
+/// 2³¹ leaves of 8-wide nodes is under 32 levels deep when balanced; PLOC trees are not balanced,
+/// so the bound is kept wide (a deeper tree panics on the push rather than writing past it).
+const STACK: usize = 1024;
+
+/// The traversal stack, left uninitialised: zeroing 1024 entries per ray cost more than tracing
+/// the Cornell box (measured: 2.8 against 4.8 Mrays/s).
+struct Stack<T: Copy> {
+    items: [std::mem::MaybeUninit<T>; STACK],
+    len: usize,
+}
+
+impl<T: Copy + PartialOrd> Stack<T> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack {
+            items: [const { std::mem::MaybeUninit::uninit() }; STACK],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    #[inline(always)]
+    fn push(&mut self, x: T) {
+        self.items[self.len].write(x);
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<T> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: every slot below `len` was written by `push` or `insert_descending`.
+        Some(unsafe { self.items[self.len].assume_init() })
+    }
+
+    /// Push `x` into the run `base..len`, which is sorted descending, keeping it sorted (the
+    /// smallest on top).
+    #[inline(always)]
+    fn insert_descending(&mut self, base: usize, x: T) {
+        let mut j = self.len;
+        assert!(j < STACK, "BVH traversal stack overflow");
+        // SAFETY: slots base..len are initialised.
+        while j > base && unsafe { self.items[j - 1].assume_init() } < x {
+            self.items[j] = self.items[j - 1];
+            j -= 1;
+        }
+        self.items[j].write(x);
+        self.len += 1;
+    }
+}
+
+/// Fill `nodes[index]` from the CWBVH node of the same index and return its exact box.
+fn refit(
+    bvh: &CwBvh,
+    index: usize,
+    prim_box: &impl Fn(usize) -> ([f32; 3], [f32; 3]),
+    nodes: &mut [Node],
+) -> ([f32; 3], [f32; 3]) {
+    let src = bvh.nodes[index];
+    let mut whole = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let mut internal = 0u32;
+    for slot in 0..8 {
+        let meta = src.child_meta[slot];
+        if meta == 0 {
+            continue;
+        }
+        let (child, (lo, hi)) = if src.imask & (1 << slot) != 0 {
+            let child = src.child_base_idx + internal;
+            internal += 1;
+            (child, refit(bvh, child as usize, prim_box, nodes))
+        } else {
+            let first = src.primitive_base_idx + (meta & 0b1_1111) as u32;
+            let count = (meta >> 5).count_ones();
+            let mut b = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+            for p in first..first + count {
+                let (lo, hi) = prim_box(p as usize);
+                b = union(b, (lo, hi));
+            }
+            assert!(
+                first < 1 << 28,
+                "more primitives than a leaf reference can address"
+            );
+            (LEAF | first << 3 | count, b)
+        };
+        let node = &mut nodes[index];
+        for k in 0..3 {
+            node.planes[k][slot] = lo[k];
+            node.planes[3 + k][slot] = hi[k];
+        }
+        node.child[slot] = child;
+        whole = union(whole, (lo, hi));
+    }
+    whole
+}
+
+fn union(a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])) -> ([f32; 3], [f32; 3]) {
+    (
+        std::array::from_fn(|k| a.0[k].min(b.0[k])),
+        std::array::from_fn(|k| a.1[k].max(b.1[k])),
+    )
+}
+
+fn detect_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// The slab test of the eight children, one lane at a time: bit k of the result is set when the
+/// ray meets child k's box within `[tmin, tmax]`, and `dist[k]` is then its entry distance.
+#[inline(always)]
+fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mut [f32; 8]) -> u32 {
+    let mut mask = 0;
+    for k in 0..8 {
+        let mut near = tmin;
+        let mut far = tmax;
+        for a in 0..3 {
+            let n = (node.planes[ray.near[a]][k] - ray.origin[a]) * ray.inv[a];
+            let f =
+                (node.planes[(ray.near[a] + 3) % 6][k] - ray.origin[a]) * ray.inv[a] * FAR_SCALE;
+            // `f32::max`/`min` return the other operand when one is NaN.
+            near = near.max(n);
+            far = far.min(f);
+        }
+        dist[k] = near;
+        if near <= far {
+            mask |= 1 << k;
+        }
+    }
+    mask
+}
+
+/// [`node_hits_portable`] for all eight lanes at once (AVX2). Same operations, same order per
+/// lane, so the same mask and distances: `max`/`min` of two non-NaN floats are exact, a NaN
+/// operand is skipped by both, and the running bounds never hold −0 (they start at `tmin` > 0
+/// or compare only against it).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn node_hits_avx2(
+    node: &Node,
+    ray: &BoxRay,
+    tmin: f32,
+    tmax: f32,
+    dist: &mut [f32; 8],
+) -> u32 {
+    use std::arch::x86_64::*;
+    let p = node.planes.as_ptr() as *const f32;
+    let scale = _mm256_set1_ps(FAR_SCALE);
+    let mut near = _mm256_set1_ps(tmin);
+    let mut far = _mm256_set1_ps(tmax);
+    for a in 0..3 {
+        let o = _mm256_set1_ps(ray.origin[a]);
+        let inv = _mm256_set1_ps(ray.inv[a]);
+        let row_near = ray.near[a];
+        let row_far = (row_near + 3) % 6;
+        // SAFETY: rows are 32-byte aligned (`Node` is `align(32)`, each row 32 bytes).
+        let n = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p.add(8 * row_near)), o), inv);
+        let f = _mm256_mul_ps(
+            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p.add(8 * row_far)), o), inv),
+            scale,
+        );
+        // maxps/minps return their second operand when either is NaN: the running bound.
+        near = _mm256_max_ps(n, near);
+        far = _mm256_min_ps(f, far);
+    }
+    _mm256_storeu_ps(dist.as_mut_ptr(), near);
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn node(boxes: &[([f32; 3], [f32; 3])]) -> Node {
+        let mut n = Node {
+            planes: [
+                [f32::INFINITY; 8],
+                [f32::INFINITY; 8],
+                [f32::INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+            ],
+            child: [EMPTY; 8],
+        };
+        for (k, (lo, hi)) in boxes.iter().enumerate() {
+            for a in 0..3 {
+                n.planes[a][k] = lo[a];
+                n.planes[3 + a][k] = hi[a];
+            }
+        }
+        n
+    }
+
+    fn coordinate() -> impl Strategy<Value = f32> {
+        // Grid-like values, so that origins often lie exactly on box planes.
+        prop_oneof![(-4i32..5).prop_map(|x| x as f32 * 0.25), -2.0f32..2.0]
+    }
+
+    fn direction() -> impl Strategy<Value = f32> {
+        prop_oneof![Just(0.0f32), Just(-0.0f32), -1.0f32..1.0]
+    }
+
+    proptest! {
+        /// The AVX2 node test is the portable one's twin: the same hit mask and the same entry
+        /// distances bit for bit, with empty slots, flat boxes and zero direction components.
+        #[test]
+        fn avx2_node_test_equals_the_portable_one(
+            boxes in prop::collection::vec((prop::array::uniform3(coordinate()), prop::array::uniform3(0u8..3)), 0..=8),
+            o in prop::array::uniform3(coordinate()),
+            d in prop::array::uniform3(direction()),
+            tmax in prop_oneof![Just(f32::INFINITY), 0.1f32..5.0],
+        ) {
+            let boxes: Vec<_> = boxes
+                .iter()
+                .map(|(lo, size)| (*lo, std::array::from_fn(|a| lo[a] + size[a] as f32 * 0.25)))
+                .collect();
+            let n = node(&boxes);
+            let ray = BoxRay::new(o, d);
+            let mut a = [0.0; 8];
+            let ma = node_hits_portable(&n, &ray, 1e-4, tmax, &mut a);
+            // Exact reference: the ray meets the box where every axis allows it.
+            for (k, (lo, hi)) in boxes.iter().enumerate() {
+                let (mut near, mut far) = (1e-4f64, tmax as f64);
+                for ax in 0..3 {
+                    let (o, d) = (o[ax] as f64, d[ax] as f64);
+                    if d == 0.0 {
+                        if (o < lo[ax] as f64) || (o > hi[ax] as f64) {
+                            far = -1.0;
+                        }
+                    } else {
+                        let (t0, t1) = ((lo[ax] as f64 - o) / d, (hi[ax] as f64 - o) / d);
+                        near = near.max(t0.min(t1));
+                        far = far.min(t0.max(t1));
+                    }
+                }
+                if near <= far {
+                    prop_assert!(ma & (1 << k) != 0, "box {k} {lo:?}..{hi:?} missed, exact {near}..{far}");
+                }
+            }
+            prop_assert_eq!(ma >> boxes.len(), 0, "an empty slot was entered");
+            #[cfg(target_arch = "x86_64")]
+            if detect_avx2() {
+                let mut b = [0.0; 8];
+                // SAFETY: AVX2 and FMA detected.
+                let mb = unsafe { node_hits_avx2(&n, &ray, 1e-4, tmax, &mut b) };
+                prop_assert_eq!(ma, mb);
+                for k in 0..8 {
+                    if ma & (1 << k) != 0 {
+                        prop_assert_eq!(a[k].to_bits(), b[k].to_bits());
+                    }
+                }
+            }
+        }
+    }
+}
