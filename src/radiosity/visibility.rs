@@ -9,8 +9,8 @@
 //! of two hits at the same distance (a shared edge) the lower leaf slot wins.
 
 use super::geometry::Frame;
-use super::watertight::{TriangleLanes, Watertight};
-use super::wide_bvh::{BoxRay, ClosestLeaf, WideBvh};
+use super::watertight::{TriangleBlocks, Watertight};
+use super::wide_bvh::{AnyLeaf, BoxRay, ClosestLeaf, WideBvh};
 use crate::scene::Scene;
 use glam::{DVec3, Vec3A};
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
@@ -24,12 +24,11 @@ pub struct Visibility {
     tris: Vec<Triangle>,
     /// Scene triangle index of each BVH triangle.
     ids: Vec<u32>,
-    /// The triangle of every BVH primitive slot, in leaf order (a triangle split into several
-    /// boxes appears once per box): a leaf's triangles are contiguous in memory and reached
-    /// without the `primitive_indices` indirection.
-    slots: Vec<Slot>,
-    /// The slots' triangles by component, for four-at-a-time leaf tests.
-    lanes: TriangleLanes,
+    /// The triangles of each BVH leaf, one four-lane block per leaf (a triangle split into
+    /// several boxes appears once per box). Slot `4·leaf + lane` names one.
+    blocks: TriangleBlocks,
+    /// Scene triangle index and unit geometric normal (counter-clockwise winding) of each slot.
+    info: Vec<SlotInfo>,
     /// Smallest ray parameter accepted, in grid units (above f32 self-intersection noise).
     pub epsilon: f32,
 }
@@ -70,37 +69,44 @@ impl Visibility {
         // obvhs's highest-quality preset: on the furnished room (78,324 triangles) it traces
         // 2.3x the rays per second of `slow_build` for 2x its build time (0.15 s against
         // 0.07 s), where the form-factor stage casts millions of rays (benches/visibility_embree.rs).
-        let bvh = build_cwbvh_from_tris(
+        let cw = build_cwbvh_from_tris(
             &tris,
             BvhBuildParams::very_slow_build(),
             &mut Duration::default(),
         );
-        let slots: Vec<Slot> = bvh
-            .primitive_indices
-            .iter()
-            .map(|&k| {
-                let t = &tris[k as usize];
-                Slot {
-                    v: [t.v0, t.v1, t.v2],
-                    normal: normals[k as usize],
-                    k,
-                }
-            })
-            .collect();
-        let bvh = WideBvh::from_cwbvh(&bvh, |i| {
-            let v: &[Vec3A; 3] = &slots[i].v;
+        let bvh = WideBvh::from_cwbvh(&cw, |i| {
+            let t = &tris[cw.primitive_indices[i] as usize];
             (
-                v[0].min(v[1]).min(v[2]).to_array(),
-                v[0].max(v[1]).max(v[2]).to_array(),
+                t.v0.min(t.v1).min(t.v2).to_array(),
+                t.v0.max(t.v1).max(t.v2).to_array(),
             )
         });
-        let lanes = TriangleLanes::new(&slots.iter().map(|s| s.v).collect::<Vec<_>>());
+        let mut blocks = TriangleBlocks::default();
+        let mut info = Vec::with_capacity(4 * bvh.leaves().len());
+        for &(first, count) in bvh.leaves() {
+            let ks = &cw.primitive_indices[first as usize..(first + count) as usize];
+            let leaf: Vec<[Vec3A; 3]> = ks
+                .iter()
+                .map(|&k| {
+                    let t = &tris[k as usize];
+                    [t.v0, t.v1, t.v2]
+                })
+                .collect();
+            blocks.push(&leaf);
+            info.extend((0..4).map(|lane| {
+                let k = ks[lane.min(ks.len() - 1)] as usize;
+                SlotInfo {
+                    normal: normals[k].to_array(),
+                    triangle: triangles[k],
+                }
+            }));
+        }
         Visibility {
             bvh,
-            lanes,
+            blocks,
+            info,
             tris,
             ids: triangles.to_vec(),
-            slots,
             epsilon: ray_epsilon(extent),
         }
     }
@@ -132,10 +138,10 @@ impl Visibility {
     /// The closest hit along `dir` (unit) from `origin`. Callers start rays slightly off the
     /// surface (lifted by [`Visibility::epsilon`] along its normal), so every hit with t ≥ 0 counts.
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let start = origin - dir * BACKOFF as f64;
-        let wt = Watertight::new(start, dir);
+        let start = Vec3A::from((origin - dir * BACKOFF as f64).as_vec3());
         let d = Vec3A::from(dir.as_vec3());
-        let ray = BoxRay::new(start.as_vec3().to_array(), d.to_array());
+        let wt = Watertight::new(start, d);
+        let ray = BoxRay::new(start.to_array(), d.to_array());
         let mut leaf = Closest {
             vis: self,
             wt: &wt,
@@ -143,33 +149,46 @@ impl Visibility {
             best: u32::MAX,
         };
         let t = self.bvh.closest(&ray, BACKOFF, f32::INFINITY, &mut leaf);
-        let slot = self.slots.get(leaf.best as usize)?;
+        self.hit(leaf.best, t, d)
+    }
+
+    /// The hit on slot `s` (none for `u32::MAX`) at `t` from the backed-off start.
+    #[inline(always)]
+    fn hit(&self, s: u32, t: f32, d: Vec3A) -> Option<Hit> {
+        let info = self.info.get(s as usize)?;
         Some(Hit {
-            triangle: self.ids[slot.k as usize],
+            triangle: info.triangle,
             t: t - BACKOFF,
-            front: slot.normal.dot(d) < 0.0,
+            front: Vec3A::from(info.normal).dot(d) < 0.0,
         })
+    }
+
+    /// Every slot as (slot, triangle), in slot order.
+    fn all_slots(&self) -> impl Iterator<Item = (u32, [Vec3A; 3])> + '_ {
+        self.bvh
+            .leaves()
+            .iter()
+            .enumerate()
+            .flat_map(move |(leaf, &(_, count))| {
+                (0..count as usize)
+                    .map(move |k| ((4 * leaf + k) as u32, self.blocks.triangle(leaf, k)))
+            })
     }
 
     /// [`Visibility::closest_hit`] by testing every triangle slot in order with the scalar test:
     /// the same answer bit for bit (tests/radiosity_visibility.rs), without the tree.
     pub fn closest_hit_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
         let start = origin - dir * BACKOFF as f64;
-        let wt = Watertight::new(start, dir);
+        let wt = Watertight::from_f64(start, dir);
         let d = Vec3A::from(dir.as_vec3());
-        let mut best: Option<(f32, &Slot)> = None;
-        for slot in &self.slots {
-            let tmax = best.map_or(f32::INFINITY, |b| b.0);
-            let t = self.slot_distance(&wt, slot, d, BACKOFF, tmax);
-            if t < tmax {
-                best = Some((t, slot));
+        let (mut best, mut tmax) = (u32::MAX, f32::INFINITY);
+        for (s, tri) in self.all_slots() {
+            let t = wt.intersect(&tri, BACKOFF, tmax);
+            if self.counts(s, t, d) && t < tmax {
+                (best, tmax) = (s, t);
             }
         }
-        best.map(|(t, slot)| Hit {
-            triangle: self.ids[slot.k as usize],
-            t: t - BACKOFF,
-            front: slot.normal.dot(d) < 0.0,
-        })
+        self.hit(best, tmax, d)
     }
 
     /// [`Visibility::occluded`] by testing every triangle slot with the scalar test.
@@ -179,35 +198,25 @@ impl Visibility {
         if len <= 0.0 {
             return false;
         }
-        let dir = delta / len;
-        let wt = Watertight::new(from - dir * BACKOFF as f64, dir);
+        let dir = delta * (1.0 / len);
+        let wt = Watertight::from_f64(from - dir * BACKOFF as f64, dir);
         let d = Vec3A::from(dir.as_vec3());
         let tmax = len as f32 + BACKOFF;
-        self.slots
-            .iter()
-            .any(|slot| self.slot_distance(&wt, slot, d, BACKOFF, tmax).is_finite())
+        self.all_slots()
+            .any(|(s, tri)| self.counts(s, wt.intersect(&tri, BACKOFF, tmax), d))
     }
 
-    /// Distance along the ray of `wt` (which starts `start` before the caller's origin) to the
-    /// triangle of `slot`, or infinity. A back face closer than [`Visibility::epsilon`] to the origin
-    /// is a surface the origin lies on (within rounding: a sample on the edge of a concave
-    /// corner lies in the plane of the adjoining wall) and that the ray leaves through its front
-    /// side, so it does not stop the ray; a front face at any distance does.
-    #[inline]
-    fn slot_distance(&self, wt: &Watertight, slot: &Slot, d: Vec3A, start: f32, tmax: f32) -> f32 {
-        let t = wt.intersect(&slot.v, start, tmax);
-        if t.is_finite() && t - start < self.epsilon && slot.normal.dot(d) >= 0.0 {
-            f32::INFINITY
-        } else {
-            t
-        }
-    }
-
-    /// Whether a finite distance `t` of the watertight test to slot `s` stops the ray: the rule
-    /// of [`Visibility::slot_distance`].
+    /// Whether a distance `t` of the watertight test (from the start `BACKOFF` behind the
+    /// caller's origin) to slot `s` stops the ray. Infinity (a miss) does not. A back face closer
+    /// than [`Visibility::epsilon`] to the origin does not either: it is a surface the origin lies
+    /// on (within rounding: a sample on the edge of a concave corner lies in the plane of the
+    /// adjoining wall), which the ray leaves through its front side. A front face at any distance
+    /// does.
     #[inline(always)]
     fn counts(&self, s: u32, t: f32, d: Vec3A) -> bool {
-        t.is_finite() && (t - BACKOFF >= self.epsilon || self.slots[s as usize].normal.dot(d) < 0.0)
+        t.is_finite()
+            && (t - BACKOFF >= self.epsilon
+                || Vec3A::from(self.info[s as usize].normal).dot(d) < 0.0)
     }
 
     /// True when a surface lies on the segment from `from` to `to` (both lifted off their
@@ -218,18 +227,38 @@ impl Visibility {
         if len <= 0.0 {
             return false;
         }
-        let dir = delta / len;
-        let start = from - dir * BACKOFF as f64;
-        let wt = Watertight::new(start, dir);
+        let dir = delta * (1.0 / len);
+        let start = Vec3A::from((from - dir * BACKOFF as f64).as_vec3());
         let d = Vec3A::from(dir.as_vec3());
-        let ray = BoxRay::new(start.as_vec3().to_array(), d.to_array());
+        let wt = Watertight::new(start, d);
+        let ray = BoxRay::new(start.to_array(), d.to_array());
         let tmax = len as f32 + BACKOFF;
-        self.bvh.any(&ray, BACKOFF, tmax, |first, count| {
-            let ts = self
-                .lanes
-                .intersect4(&wt, first as usize, count as usize, BACKOFF, tmax);
-            (0..count as usize).any(|k| self.counts(first + k as u32, ts[k], d))
-        })
+        let mut leaf = Occluding {
+            vis: self,
+            wt: &wt,
+            d,
+            tmax,
+        };
+        self.bvh.any(&ray, BACKOFF, tmax, &mut leaf)
+    }
+}
+
+/// The occlusion leaf test: some slot's watertight distance counts and lies within `tmax`.
+struct Occluding<'a> {
+    vis: &'a Visibility,
+    wt: &'a Watertight,
+    d: Vec3A,
+    tmax: f32,
+}
+
+impl AnyLeaf for Occluding<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, leaf: u32, count: u32) -> bool {
+        let ts =
+            self.vis
+                .blocks
+                .intersect4(self.wt, leaf as usize, count as usize, BACKOFF, self.tmax);
+        (0..count as usize).any(|k| self.vis.counts(4 * leaf + k as u32, ts[k], self.d))
     }
 }
 
@@ -244,13 +273,13 @@ struct Closest<'a> {
 
 impl ClosestLeaf for Closest<'_> {
     #[inline(always)]
-    fn leaf(&mut self, first: u32, count: u32, mut tmax: f32) -> f32 {
+    fn leaf(&mut self, leaf: u32, count: u32, mut tmax: f32) -> f32 {
         let ts = self
             .vis
-            .lanes
-            .intersect4(self.wt, first as usize, count as usize, BACKOFF, tmax);
+            .blocks
+            .intersect4(self.wt, leaf as usize, count as usize, BACKOFF, tmax);
         for (k, &t) in ts.iter().enumerate().take(count as usize) {
-            let s = first + k as u32;
+            let s = 4 * leaf + k as u32;
             if !self.vis.counts(s, t, self.d) {
                 continue;
             }
@@ -263,12 +292,10 @@ impl ClosestLeaf for Closest<'_> {
     }
 }
 
-/// A BVH primitive slot: its triangle's vertices (grid coordinates), unit normal and index
-/// in the BVH's triangle list.
-struct Slot {
-    v: [Vec3A; 3],
-    normal: Vec3A,
-    k: u32,
+/// What a hit on a slot reports: the scene triangle and its unit normal.
+struct SlotInfo {
+    normal: [f32; 3],
+    triangle: u32,
 }
 
 /// The ray epsilon for a grid whose largest coordinate is `extent`: a few hundred f32 ulps of the

@@ -1,6 +1,5 @@
 //! Watertight ray/triangle intersection, one triangle at a time or four in SSE lanes with the
-//! same operations in the same order (so the same distances bit for bit, up to the sign of
-//! zeros, which no comparison below sees).
+//! same operations in the same order (so the same distances bit for bit).
 
 use glam::{DVec3, Vec3A};
 
@@ -8,21 +7,22 @@ use glam::{DVec3, Vec3A};
 /// shared edge or vertex of two triangles hits at least one of them, so closed scenes do not leak
 /// rays through their seams (obvhs's Möller–Trumbore test does).
 ///
-/// The paper's shear `(a[kx] − sx·a[kz], a[ky] − sy·a[kz], sz·a[kz])` of a vertex a (relative to
-/// the origin) is taken as three dot products with rows holding 1, −s and 0 in the permuted
-/// axes: each product by 1 or 0 is exact and adding an exact 0 changes nothing, so every value
-/// is the paper's bit for bit (no FMA contraction in Rust), without indexing by kx, ky, kz.
+/// The paper's shear of a vertex a (relative to the origin) is `(a[kx] + a[kz]·(−sx),
+/// a[ky] + a[kz]·(−sy), a[kz]·sz)` with `sz = 1/d[kz]`, `sx = d[kx]·sz`, `sy = d[ky]·sz` (one
+/// division; watertightness needs only that every vertex of a ray's triangles is sheared the
+/// same way), with no FMA contraction (Rust has none), here and in every SSE lane of
+/// [`TriangleBlocks::intersect4`].
 pub struct Watertight {
     origin: Vec3A,
-    rows: [Vec3A; 3],
-    /// The permuted axes (kx, ky, kz) and the shear (−sx, −sy, sz) for the lane-wise test.
+    /// The permuted axes (kx, ky, kz) and the shear (−sx, −sy, sz).
     axes: [usize; 3],
     shear: [f32; 3],
 }
 
 impl Watertight {
-    pub fn new(origin: DVec3, dir: DVec3) -> Self {
-        let d = dir.as_vec3();
+    /// For the ray from `origin` along `d` (f32; both as the caller rounded them).
+    #[inline]
+    pub fn new(origin: Vec3A, d: Vec3A) -> Self {
         let a = d.abs();
         let kz = if a.x >= a.y && a.x >= a.z {
             0
@@ -35,34 +35,27 @@ impl Watertight {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        let row = |k: usize, kz_weight: f32| {
-            let mut r = [0.0f32; 3];
-            r[k] = 1.0;
-            r[kz] = kz_weight;
-            Vec3A::from_array(r)
-        };
         let sz = 1.0 / d[kz];
-        let mut z = [0.0f32; 3];
-        z[kz] = sz;
         Watertight {
             axes: [kx, ky, kz],
-            shear: [-(d[kx] / d[kz]), -(d[ky] / d[kz]), sz],
-            origin: Vec3A::from(origin.as_vec3()),
-            rows: [
-                row(kx, -(d[kx] / d[kz])),
-                row(ky, -(d[ky] / d[kz])),
-                Vec3A::from_array(z),
-            ],
+            shear: [-(d[kx] * sz), -(d[ky] * sz), sz],
+            origin,
         }
+    }
+
+    /// For an f64 ray, rounded to f32.
+    pub fn from_f64(origin: DVec3, dir: DVec3) -> Self {
+        Watertight::new(Vec3A::from(origin.as_vec3()), Vec3A::from(dir.as_vec3()))
     }
 
     /// Distance to the triangle, or infinity when missed or outside `[tmin, tmax]`.
     #[inline]
     pub fn intersect(&self, v: &[Vec3A; 3], tmin: f32, tmax: f32) -> f32 {
-        let [rx, ry, rz] = self.rows;
+        let [kx, ky, kz] = self.axes;
+        let [nsx, nsy, sz] = self.shear;
         let shear = |p: Vec3A| {
-            let q = p - self.origin;
-            (q.dot(rx), q.dot(ry), q.dot(rz))
+            let q = (p - self.origin).to_array();
+            (q[kx] + q[kz] * nsx, q[ky] + q[kz] * nsy, q[kz] * sz)
         };
         let ((ax, ay, az), (bx, by, bz), (cx, cy, cz)) = (shear(v[0]), shear(v[1]), shear(v[2]));
         let mut u = cx * by - cy * bx;
@@ -89,52 +82,69 @@ impl Watertight {
     }
 }
 
-/// Triangles stored by component (structure of arrays) in slot order, padded by four copies of
-/// the last triangle, so that the four slots from any index load as one SSE vector each.
-pub struct TriangleLanes {
-    /// `v[i][c][s]`: component c of vertex i of slot s.
-    v: [[Vec<f32>; 3]; 3],
+/// Up to four triangles stored by vertex, component and lane, so that each component of the
+/// four loads as one SSE vector: one block per BVH leaf, contiguous (144 bytes).
+#[derive(Clone, Copy)]
+#[repr(C, align(16))]
+struct Block {
+    /// `v[i][c][k]`: component c of vertex i of lane k.
+    v: [[[f32; 4]; 3]; 3],
 }
 
-impl TriangleLanes {
-    pub fn new(tris: &[[Vec3A; 3]]) -> Self {
-        let mut v: [[Vec<f32>; 3]; 3] = Default::default();
-        for (i, vi) in v.iter_mut().enumerate() {
-            for (c, vc) in vi.iter_mut().enumerate() {
-                vc.extend(tris.iter().map(|t| t[i][c]));
-                let last = vc.last().copied().unwrap_or(0.0);
-                vc.extend([last; 4]);
+/// The triangles of every BVH leaf, one four-lane block each.
+#[derive(Default)]
+pub struct TriangleBlocks {
+    blocks: Vec<Block>,
+}
+
+impl TriangleBlocks {
+    /// Append a block of `tris` (1 to 4 triangles); unused lanes repeat the first triangle.
+    pub fn push(&mut self, tris: &[[Vec3A; 3]]) {
+        assert!(
+            (1..=4).contains(&tris.len()),
+            "a block holds 1 to 4 triangles"
+        );
+        let mut b = Block {
+            v: [[[0.0; 4]; 3]; 3],
+        };
+        for k in 0..4 {
+            let t = tris.get(k).unwrap_or(&tris[0]);
+            for (i, vi) in b.v.iter_mut().enumerate() {
+                for (c, vc) in vi.iter_mut().enumerate() {
+                    vc[k] = t[i][c];
+                }
             }
         }
-        TriangleLanes { v }
+        self.blocks.push(b);
     }
 
-    /// The distances of [`Watertight::intersect`] to slots `first..first + 4` (lanes `count..`
-    /// are left out: infinity).
+    /// Lane `k`'s triangle of block `block`.
+    pub fn triangle(&self, block: usize, k: usize) -> [Vec3A; 3] {
+        let b = &self.blocks[block];
+        std::array::from_fn(|i| Vec3A::new(b.v[i][0][k], b.v[i][1][k], b.v[i][2][k]))
+    }
+
+    /// The distances of [`Watertight::intersect`] to the triangles of block `block` (lanes
+    /// `count..` are left out: infinity).
     #[inline(always)]
     pub fn intersect4(
         &self,
         wt: &Watertight,
-        first: usize,
+        block: usize,
         count: usize,
         tmin: f32,
         tmax: f32,
     ) -> [f32; 4] {
         #[cfg(target_arch = "x86_64")]
         {
-            // SAFETY: SSE2 is part of x86_64; `first + 4` is within the padded arrays when
-            // `first` is a slot.
-            unsafe { self.intersect4_sse(wt, first, count, tmin, tmax) }
+            // SAFETY: SSE2 is part of x86_64.
+            unsafe { self.intersect4_sse(wt, block, count, tmin, tmax) }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
             std::array::from_fn(|k| {
                 if k < count {
-                    let s = first + k;
-                    let v = std::array::from_fn(|i| {
-                        Vec3A::new(self.v[i][0][s], self.v[i][1][s], self.v[i][2][s])
-                    });
-                    wt.intersect(&v, tmin, tmax)
+                    wt.intersect(&self.triangle(block, k), tmin, tmax)
                 } else {
                     f32::INFINITY
                 }
@@ -147,7 +157,7 @@ impl TriangleLanes {
     unsafe fn intersect4_sse(
         &self,
         wt: &Watertight,
-        first: usize,
+        block: usize,
         count: usize,
         tmin: f32,
         tmax: f32,
@@ -160,16 +170,13 @@ impl TriangleLanes {
             _mm_set1_ps(wt.shear[1]),
             _mm_set1_ps(wt.shear[2]),
         );
-        assert!(first + 4 <= self.v[0][0].len());
+        let b = &self.blocks[block];
         let load = |i: usize, c: usize| {
-            // SAFETY: in bounds (asserted above).
-            _mm_sub_ps(
-                _mm_loadu_ps(self.v[i][c].as_ptr().add(first)),
-                _mm_set1_ps(o[c]),
-            )
+            // SAFETY: a lane row is four f32, 16-byte aligned (`Block` is `align(16)`).
+            _mm_sub_ps(_mm_load_ps(b.v[i][c].as_ptr()), _mm_set1_ps(o[c]))
         };
-        // Sheared vertex i: (q[kx] + q[kz]·(−sx), q[ky] + q[kz]·(−sy), q[kz]·sz), the scalar
-        // test's dot products without their exact zero terms.
+        // Sheared vertex i: (q[kx] + q[kz]·(−sx), q[ky] + q[kz]·(−sy), q[kz]·sz), as in the
+        // scalar test.
         let shear = |i: usize| {
             let (qx, qy, qz) = (load(i, kx), load(i, ky), load(i, kz));
             (
@@ -227,11 +234,7 @@ impl TriangleLanes {
         while redo != 0 {
             let k = redo.trailing_zeros() as usize;
             redo &= redo - 1;
-            let s = first + k;
-            let v = std::array::from_fn(|i| {
-                Vec3A::new(self.v[i][0][s], self.v[i][1][s], self.v[i][2][s])
-            });
-            out[k] = wt.intersect(&v, tmin, tmax);
+            out[k] = wt.intersect(&self.triangle(block, k), tmin, tmax);
         }
         out
     }

@@ -19,8 +19,8 @@
 
 use obvhs::cwbvh::CwBvh;
 
-/// A child reference: a node index, or a leaf (`LEAF` bit set) holding `count` (≤ 7) primitives
-/// from `first`: `LEAF | first << 3 | count`.
+/// A child reference: a node index, or a leaf (`LEAF` bit set): `LEAF | leaf << 3 | count`, the
+/// leaf's number (its position in [`WideBvh::leaves`], depth-first order) and its primitive count.
 const LEAF: u32 = 1 << 31;
 const EMPTY: u32 = u32::MAX;
 
@@ -36,9 +36,11 @@ struct Node {
     child: [u32; 8],
 }
 
-/// The tree. Primitive indices are positions in the `CwBvh`'s `primitive_indices` (leaf order).
+/// The tree. Leaf tests get a leaf's number; [`WideBvh::leaves`] maps it to its primitives.
 pub struct WideBvh {
     nodes: Vec<Node>,
+    /// Each leaf's primitives as (first, count): positions in the `CwBvh`'s `primitive_indices`.
+    leaves: Vec<(u32, u32)>,
     root: u32,
     avx2: bool,
     /// Boxes up to this far beyond `tmax` are still entered: a leaf test's distance is rounded
@@ -48,37 +50,75 @@ pub struct WideBvh {
     margin: f32,
 }
 
-/// A ray prepared for the slab tests: origin, reciprocal direction and the plane rows nearest
-/// the origin per axis.
+/// A ray prepared for the slab tests, which compute a plane's distance as one fused
+/// multiply-subtract `b·(1/d) − o·(1/d)`.
 ///
-/// A zero direction component gives an infinite reciprocal of the zero's sign (and the near row
-/// by that sign), so a slab the ray runs parallel to yields ±∞ from planes on either side of the
-/// origin and NaN (0 · ∞) from a plane through it; the min/max below keep the running bound when
-/// one operand is NaN, so such a plane constrains nothing — the exact answer for a ray lying in a
-/// box face.
+/// Rounding: `1/d`, the product `o·(1/d)` and the fused result are each rounded. The product's
+/// error is absolute (up to an ulp of `o/d`, which can dwarf the distance), so the offset is
+/// stored twice, pushed 4 ulps outward: the near planes subtract `o/d + e` and the far planes
+/// `o/d − e`, which moves every near distance down and every far one up by more than that
+/// error. The other two roundings are relative to the distance and covered by scaling the far
+/// distance by 1 + 2γ₃ (Ize, "Robust BVH ray traversal", JCGT 2013). So a box the exact ray
+/// meets within `[tmin, tmax]` is always entered.
+///
+/// A direction component under 2⁻⁶⁴ in magnitude (zero included) is replaced by ±2⁻⁶⁴ (the
+/// sign of the component, so −0 counts as negative) and its slab widened by 2⁻³² on both sides
+/// (2³² added to the offsets' push): up to t = 2³², far beyond any grid, the true ray stays
+/// within 2⁻³² of its origin on that axis, so the widened slab holds it wherever the slab does,
+/// and nothing is ever ∞ − ∞ or 0 · ∞ (the proptest below checks against exact slabs).
 #[derive(Clone, Copy)]
 pub struct BoxRay {
-    origin: [f32; 3],
     inv: [f32; 3],
+    /// `o/d` pushed outward: subtracted for the near planes (`near_offset` ≥ o/d) and for the
+    /// far planes (`far_offset` ≤ o/d).
+    near_offset: [f32; 3],
+    far_offset: [f32; 3],
     /// For each axis the plane row (0..6) a ray enters the slab through.
     near: [usize; 3],
 }
 
 impl BoxRay {
     pub fn new(origin: [f32; 3], dir: [f32; 3]) -> Self {
-        BoxRay {
-            origin,
-            inv: dir.map(|d| 1.0 / d),
-            near: std::array::from_fn(|k| if dir[k].is_sign_negative() { 3 + k } else { k }),
+        const TINY: f32 = 1.0 / (1u64 << 63) as f32 / 2.0; // 2⁻⁶⁴
+        const WIDEN: f32 = (1u64 << 32) as f32; // 2³²: 2⁻³² of slab at 1/TINY per unit
+        let tiny = dir.map(|d| d.abs() < TINY);
+        let d: [f32; 3] = std::array::from_fn(|k| {
+            if tiny[k] {
+                TINY.copysign(dir[k])
+            } else {
+                dir[k]
+            }
+        });
+        // One division for the three axes.
+        let inv = (glam::Vec3A::ONE / glam::Vec3A::from(d)).to_array();
+        let mut ray = BoxRay {
+            inv,
+            near_offset: [0.0; 3],
+            far_offset: [0.0; 3],
+            near: [0; 3],
+        };
+        for k in 0..3 {
+            let oi = origin[k] * inv[k];
+            let e = oi.abs() * (4.0 * f32::EPSILON) + if tiny[k] { WIDEN } else { 0.0 };
+            ray.near_offset[k] = oi + e;
+            ray.far_offset[k] = oi - e;
+            ray.near[k] = if d[k] < 0.0 { 3 + k } else { k };
         }
+        ray
     }
 }
 
 /// What a leaf test reports to a closest-hit traversal.
 pub trait ClosestLeaf {
-    /// Test the primitives `first..first + count` (closest hits below `tmax`) and return the new
-    /// `tmax` (unchanged when none is closer).
-    fn leaf(&mut self, first: u32, count: u32, tmax: f32) -> f32;
+    /// Test the `count` primitives of leaf number `leaf` (closest hits below `tmax`) and return
+    /// the new `tmax` (unchanged when none is closer).
+    fn leaf(&mut self, leaf: u32, count: u32, tmax: f32) -> f32;
+}
+
+/// What a leaf test reports to an occlusion traversal.
+pub trait AnyLeaf {
+    /// Whether one of the `count` primitives of leaf number `leaf` stops the ray.
+    fn leaf(&mut self, leaf: u32, count: u32) -> bool;
 }
 
 impl WideBvh {
@@ -89,6 +129,7 @@ impl WideBvh {
         if bvh.nodes.is_empty() || bvh.primitive_indices.is_empty() {
             return WideBvh {
                 nodes: Vec::new(),
+                leaves: Vec::new(),
                 root: EMPTY,
                 avx2,
                 margin: 0.0,
@@ -108,14 +149,22 @@ impl WideBvh {
             };
             bvh.nodes.len()
         ];
-        let (lo, hi) = refit(bvh, 0, &prim_box, &mut nodes);
+        let mut leaves = Vec::new();
+        let (lo, hi) = refit(bvh, 0, &prim_box, &mut nodes, &mut leaves);
         let largest = lo.iter().chain(&hi).fold(0.0f32, |m, x| m.max(x.abs()));
         WideBvh {
             nodes,
+            leaves,
             root: 0,
             avx2,
             margin: largest * (1.0 / (1 << 18) as f32),
         }
+    }
+
+    /// Each leaf's primitives as (first, count), by leaf number: positions in the `CwBvh`'s
+    /// `primitive_indices`; count ≤ 3.
+    pub fn leaves(&self) -> &[(u32, u32)] {
+        &self.leaves
     }
 
     /// The closest hit below `tmax`: every leaf whose box the ray meets before the current
@@ -136,15 +185,9 @@ impl WideBvh {
         self.closest_with(ray, tmin, tmax, leaf, node_hits_portable)
     }
 
-    /// True when some leaf test reports a hit: `leaf(first, count)` is asked for every leaf whose
+    /// True when some leaf test reports a hit: `leaf.leaf(leaf, count)` is asked for every leaf whose
     /// box the ray meets in `[tmin, tmax]`, in no particular order, until one says true.
-    pub fn any(
-        &self,
-        ray: &BoxRay,
-        tmin: f32,
-        tmax: f32,
-        leaf: impl FnMut(u32, u32) -> bool,
-    ) -> bool {
+    pub fn any(&self, ray: &BoxRay, tmin: f32, tmax: f32, leaf: &mut impl AnyLeaf) -> bool {
         if self.root == EMPTY {
             return false;
         }
@@ -172,13 +215,7 @@ impl WideBvh {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn any_avx2(
-        &self,
-        ray: &BoxRay,
-        tmin: f32,
-        tmax: f32,
-        leaf: impl FnMut(u32, u32) -> bool,
-    ) -> bool {
+    unsafe fn any_avx2(&self, ray: &BoxRay, tmin: f32, tmax: f32, leaf: &mut impl AnyLeaf) -> bool {
         self.any_with(ray, tmin, tmax, leaf, |n, r, a, b, d| unsafe {
             node_hits_avx2(n, r, a, b, d)
         })
@@ -243,7 +280,7 @@ impl WideBvh {
         ray: &BoxRay,
         tmin: f32,
         tmax: f32,
-        mut leaf: impl FnMut(u32, u32) -> bool,
+        leaf: &mut impl AnyLeaf,
         hits: impl Fn(&Node, &BoxRay, f32, f32, &mut [f32; 8]) -> u32,
     ) -> bool {
         let mut stack = Stack::<u32>::new();
@@ -251,7 +288,7 @@ impl WideBvh {
         let mut dist = [0.0f32; 8];
         loop {
             if current & LEAF != 0 {
-                if leaf((current & !LEAF) >> 3, current & 7) {
+                if leaf.leaf((current & !LEAF) >> 3, current & 7) {
                     return true;
                 }
             } else {
@@ -335,6 +372,7 @@ fn refit(
     index: usize,
     prim_box: &impl Fn(usize) -> ([f32; 3], [f32; 3]),
     nodes: &mut [Node],
+    leaves: &mut Vec<(u32, u32)>,
 ) -> ([f32; 3], [f32; 3]) {
     let src = bvh.nodes[index];
     let mut whole = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
@@ -347,7 +385,7 @@ fn refit(
         let (child, (lo, hi)) = if src.imask & (1 << slot) != 0 {
             let child = src.child_base_idx + internal;
             internal += 1;
-            (child, refit(bvh, child as usize, prim_box, nodes))
+            (child, refit(bvh, child as usize, prim_box, nodes, leaves))
         } else {
             let first = src.primitive_base_idx + (meta & 0b1_1111) as u32;
             let count = (meta >> 5).count_ones();
@@ -356,11 +394,10 @@ fn refit(
                 let (lo, hi) = prim_box(p as usize);
                 b = union(b, (lo, hi));
             }
-            assert!(
-                first < 1 << 28,
-                "more primitives than a leaf reference can address"
-            );
-            (LEAF | first << 3 | count, b)
+            let id = leaves.len() as u32;
+            assert!(id < 1 << 28, "more leaves than a reference can address");
+            leaves.push((first, count));
+            (LEAF | id << 3 | count, b)
         };
         let node = &mut nodes[index];
         for k in 0..3 {
@@ -398,15 +435,14 @@ fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mu
     let mut mask = 0;
     for k in 0..8 {
         let mut near = tmin;
-        let mut far = tmax;
+        let mut far = f32::INFINITY;
         for a in 0..3 {
-            let n = (node.planes[ray.near[a]][k] - ray.origin[a]) * ray.inv[a];
-            let f =
-                (node.planes[(ray.near[a] + 3) % 6][k] - ray.origin[a]) * ray.inv[a] * FAR_SCALE;
-            // `f32::max`/`min` return the other operand when one is NaN.
+            let n = node.planes[ray.near[a]][k].mul_add(ray.inv[a], -ray.near_offset[a]);
+            let f = node.planes[(ray.near[a] + 3) % 6][k].mul_add(ray.inv[a], -ray.far_offset[a]);
             near = near.max(n);
             far = far.min(f);
         }
+        far = (far * FAR_SCALE).min(tmax);
         dist[k] = near;
         if near <= far {
             mask |= 1 << k;
@@ -415,10 +451,10 @@ fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mu
     mask
 }
 
-/// [`node_hits_portable`] for all eight lanes at once (AVX2). Same operations, same order per
-/// lane, so the same mask and distances: `max`/`min` of two non-NaN floats are exact, a NaN
-/// operand is skipped by both, and the running bounds never hold −0 (they start at `tmin` > 0
-/// or compare only against it).
+/// [`node_hits_portable`] for all eight lanes at once (AVX2 + FMA). Same operations, same order
+/// per lane, so the same mask and distances: `mul_add` is the fused operation, `max`/`min` of
+/// two floats are exact (no NaN arises: see [`BoxRay`]), and the running near bound never holds
+/// −0 (it starts at `tmin` > 0).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline]
@@ -431,24 +467,30 @@ unsafe fn node_hits_avx2(
 ) -> u32 {
     use std::arch::x86_64::*;
     let p = node.planes.as_ptr() as *const f32;
-    let scale = _mm256_set1_ps(FAR_SCALE);
     let mut near = _mm256_set1_ps(tmin);
-    let mut far = _mm256_set1_ps(tmax);
+    let mut far = _mm256_set1_ps(f32::INFINITY);
     for a in 0..3 {
-        let o = _mm256_set1_ps(ray.origin[a]);
         let inv = _mm256_set1_ps(ray.inv[a]);
         let row_near = ray.near[a];
         let row_far = (row_near + 3) % 6;
         // SAFETY: rows are 32-byte aligned (`Node` is `align(32)`, each row 32 bytes).
-        let n = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p.add(8 * row_near)), o), inv);
-        let f = _mm256_mul_ps(
-            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p.add(8 * row_far)), o), inv),
-            scale,
+        let n = _mm256_fmsub_ps(
+            _mm256_load_ps(p.add(8 * row_near)),
+            inv,
+            _mm256_set1_ps(ray.near_offset[a]),
         );
-        // maxps/minps return their second operand when either is NaN: the running bound.
+        let f = _mm256_fmsub_ps(
+            _mm256_load_ps(p.add(8 * row_far)),
+            inv,
+            _mm256_set1_ps(ray.far_offset[a]),
+        );
         near = _mm256_max_ps(n, near);
         far = _mm256_min_ps(f, far);
     }
+    let far = _mm256_min_ps(
+        _mm256_mul_ps(far, _mm256_set1_ps(FAR_SCALE)),
+        _mm256_set1_ps(tmax),
+    );
     _mm256_storeu_ps(dist.as_mut_ptr(), near);
     _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
 }
