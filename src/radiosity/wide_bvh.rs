@@ -433,7 +433,7 @@ fn detect_avx2() -> bool {
 #[inline(always)]
 fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mut [f32; 8]) -> u32 {
     let mut mask = 0;
-    for k in 0..8 {
+    for (k, dist) in dist.iter_mut().enumerate() {
         let mut near = tmin;
         let mut far = f32::INFINITY;
         for a in 0..3 {
@@ -443,7 +443,7 @@ fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mu
             far = far.min(f);
         }
         far = (far * FAR_SCALE).min(tmax);
-        dist[k] = near;
+        *dist = near;
         if near <= far {
             mask |= 1 << k;
         }
