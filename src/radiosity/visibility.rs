@@ -138,8 +138,7 @@ impl Visibility {
     /// The closest hit along `dir` (unit) from `origin`. Callers start rays slightly off the
     /// surface (lifted by [`Visibility::epsilon`] along its normal), so every hit with t ≥ 0 counts.
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let start = Vec3A::from((origin - dir * BACKOFF as f64).as_vec3());
-        let d = Vec3A::from(dir.as_vec3());
+        let (start, d) = ray_start(origin, dir);
         let wt = Watertight::new(start, d);
         let ray = BoxRay::new(start.to_array(), d.to_array());
         let mut leaf = Closest {
@@ -178,9 +177,8 @@ impl Visibility {
     /// [`Visibility::closest_hit`] by testing every triangle slot in order with the scalar test:
     /// the same answer bit for bit (tests/radiosity_visibility.rs), without the tree.
     pub fn closest_hit_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let start = origin - dir * BACKOFF as f64;
-        let wt = Watertight::from_f64(start, dir);
-        let d = Vec3A::from(dir.as_vec3());
+        let (start, d) = ray_start(origin, dir);
+        let wt = Watertight::new(start, d);
         let (mut best, mut tmax) = (u32::MAX, f32::INFINITY);
         for (s, tri) in self.all_slots() {
             let t = wt.intersect(&tri, BACKOFF, tmax);
@@ -193,15 +191,10 @@ impl Visibility {
 
     /// [`Visibility::occluded`] by testing every triangle slot with the scalar test.
     pub fn occluded_brute_force(&self, from: DVec3, to: DVec3) -> bool {
-        let delta = to - from;
-        let len = delta.length();
-        if len <= 0.0 {
+        let Some((start, d, tmax)) = segment(from, to) else {
             return false;
-        }
-        let dir = delta * (1.0 / len);
-        let wt = Watertight::from_f64(from - dir * BACKOFF as f64, dir);
-        let d = Vec3A::from(dir.as_vec3());
-        let tmax = len as f32 + BACKOFF;
+        };
+        let wt = Watertight::new(start, d);
         self.all_slots()
             .any(|(s, tri)| self.counts(s, wt.intersect(&tri, BACKOFF, tmax), d))
     }
@@ -222,17 +215,11 @@ impl Visibility {
     /// True when a surface lies on the segment from `from` to `to` (both lifted off their
     /// surfaces by the caller).
     pub fn occluded(&self, from: DVec3, to: DVec3) -> bool {
-        let delta = to - from;
-        let len = delta.length();
-        if len <= 0.0 {
+        let Some((start, d, tmax)) = segment(from, to) else {
             return false;
-        }
-        let dir = delta * (1.0 / len);
-        let start = Vec3A::from((from - dir * BACKOFF as f64).as_vec3());
-        let d = Vec3A::from(dir.as_vec3());
+        };
         let wt = Watertight::new(start, d);
         let ray = BoxRay::new(start.to_array(), d.to_array());
-        let tmax = len as f32 + BACKOFF;
         let mut leaf = Occluding {
             vis: self,
             wt: &wt,
@@ -296,6 +283,26 @@ impl ClosestLeaf for Closest<'_> {
 struct SlotInfo {
     normal: [f32; 3],
     triangle: u32,
+}
+
+/// A ray's start `BACKOFF` behind `origin` and its direction, in f32.
+fn ray_start(origin: DVec3, dir: DVec3) -> (Vec3A, Vec3A) {
+    (
+        Vec3A::from((origin - dir * BACKOFF as f64).as_vec3()),
+        Vec3A::from(dir.as_vec3()),
+    )
+}
+
+/// The ray of the segment `from → to`: its start, direction and `tmax` (from the start), or none
+/// for an empty segment.
+fn segment(from: DVec3, to: DVec3) -> Option<(Vec3A, Vec3A, f32)> {
+    let delta = to - from;
+    let len = delta.length();
+    if len <= 0.0 {
+        return None;
+    }
+    let (start, d) = ray_start(from, delta * (1.0 / len));
+    Some((start, d, len as f32 + BACKOFF))
 }
 
 /// The ray epsilon for a grid whose largest coordinate is `extent`: a few hundred f32 ulps of the

@@ -1,7 +1,7 @@
 //! Watertight ray/triangle intersection, one triangle at a time or four in SSE lanes with the
 //! same operations in the same order (so the same distances bit for bit).
 
-use glam::{DVec3, Vec3A};
+use glam::Vec3A;
 
 /// Watertight ray/triangle intersection (Woop, Benthin and Wald, JCGT 2013): a ray through the
 /// shared edge or vertex of two triangles hits at least one of them, so closed scenes do not leak
@@ -41,11 +41,6 @@ impl Watertight {
             shear: [-(d[kx] * sz), -(d[ky] * sz), sz],
             origin,
         }
-    }
-
-    /// For an f64 ray, rounded to f32.
-    pub fn from_f64(origin: DVec3, dir: DVec3) -> Self {
-        Watertight::new(Vec3A::from(origin.as_vec3()), Vec3A::from(dir.as_vec3()))
     }
 
     /// Distance to the triangle, or infinity when missed or outside `[tmin, tmax]`.
