@@ -49,3 +49,39 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+    /// A ray hit's patch, found with the hit triangle's own pieces bounding the search, is the
+    /// patch the plain search finds, on a soup whose voxels hold several patches of one
+    /// orientation (visibility clusters).
+    #[test]
+    fn locating_a_hit_by_its_triangle_changes_no_answer(
+        seed in 0u64..1000,
+        points in prop::collection::vec((0usize..10_000, 0.0f64..1.0, 0.0f64..1.0), 200),
+    ) {
+        let scene = fixtures::random_soup(300, seed);
+        let set = voxelize(
+            &scene,
+            &VoxelizeParams {
+                resolution: Resolution::VoxelSize(0.25),
+                samples_per_patch: 1,
+            },
+        )
+        .unwrap();
+        let loc = PatchLocator::new(&set, &scene);
+        let frame = set.frame();
+        let mut shared = 0;
+        for (pick, u, v) in points {
+            let t = (pick % scene.triangles.len()) as u32;
+            let [a, b, c] = scene.corners(t as usize).map(|x| frame.to_grid(x.to_array()));
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let p = a + (b - a) * u + (c - a) * v;
+            let axis = loc.triangle_axis(t);
+            let voxel = relume::radiosity::locate::voxel_of(p, set.dims);
+            shared += (loc.candidates(voxel, axis).len() > 1) as usize;
+            prop_assert_eq!(loc.locate_hit(p, t), loc.locate(p, axis));
+        }
+        prop_assert!(shared > 0, "no point fell in a voxel with several patches");
+    }
+}

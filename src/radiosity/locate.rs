@@ -34,6 +34,8 @@ pub struct PatchLocator {
     chunk_first: Vec<usize>,
     /// Dominant axis of each scene triangle.
     triangle_axis: Vec<u8>,
+    /// Scene triangle of each piece.
+    piece_triangle: Vec<u32>,
     /// Dense (first patch, count) per group key when the grid is small enough, else empty (then
     /// a binary search over `keys`).
     table: Vec<(u32, u32)>,
@@ -115,6 +117,7 @@ impl PatchLocator {
             chunks,
             chunk_first,
             triangle_axis,
+            piece_triangle: set.pieces.iter().map(|p| p.triangle).collect(),
             table,
         }
     }
@@ -195,9 +198,21 @@ impl PatchLocator {
         voxel: [i64; 3],
         axis: u8,
     ) -> Option<(u32, f64, DVec3)> {
+        self.nearest_in_voxel_within(p, voxel, axis, f64::INFINITY)
+    }
+
+    /// [`PatchLocator::nearest_in_voxel`] given an upper bound of the answer's distance (the
+    /// same answer: a patch that could reach or tie the nearest is never pruned).
+    fn nearest_in_voxel_within(
+        &self,
+        p: DVec3,
+        voxel: [i64; 3],
+        axis: u8,
+        bound: f64,
+    ) -> Option<(u32, f64, DVec3)> {
         // Each patch is searched within the nearest distance found so far (a patch that cannot
         // tie it returns ∞), which changes no answer.
-        let mut bound = f64::INFINITY;
+        let mut bound = bound;
         self.candidates(voxel, axis)
             .map(|i| {
                 let (d, q, _) = self.nearest_piece(p, i, bound);
@@ -209,6 +224,13 @@ impl PatchLocator {
 
     /// The patch a point `p` (grid coordinates) on a surface with dominant `axis` belongs to.
     pub fn locate(&self, p: DVec3, axis: u8) -> Option<u32> {
+        self.locate_on(p, axis, None)
+    }
+
+    /// [`PatchLocator::locate`], where `p` is known to lie on scene triangle `on` (if given):
+    /// the distance to that triangle's pieces in the voxel bounds the nearest-patch search from
+    /// the start, which prunes the other patches' pieces without changing the answer.
+    fn locate_on(&self, p: DVec3, axis: u8, on: Option<u32>) -> Option<u32> {
         let v = voxel_of(p, self.dims);
         let own = self.candidates(v, axis);
         if own.len() == 1 {
@@ -216,7 +238,20 @@ impl PatchLocator {
             // wall thinner than a voxel separates surfaces; then the nearest one decides).
             return Some(own.start as u32);
         }
-        if let Some((i, d, _)) = self.nearest_in_voxel(p, v, axis) {
+        let mut bound = f64::INFINITY;
+        if let Some(t) = on {
+            for i in own {
+                let (first, count) = self.ranges[i];
+                for k in first..first + count {
+                    if self.piece_triangle[k] == t {
+                        let (poly, n) = &self.pieces[k];
+                        let q = geometry::closest_point_on_polygon(p, poly, *n);
+                        bound = bound.min((q - p).length());
+                    }
+                }
+            }
+        }
+        if let Some((i, d, _)) = self.nearest_in_voxel_within(p, v, axis, bound) {
             if d <= ON_SURFACE {
                 return Some(i);
             }
@@ -239,7 +274,7 @@ impl PatchLocator {
 
     /// The patch of a ray hit on scene triangle `t` at `p`.
     pub fn locate_hit(&self, p: DVec3, t: u32) -> Option<u32> {
-        self.locate(p, self.triangle_axis(t))
+        self.locate_on(p, self.triangle_axis(t), Some(t))
     }
 }
 
