@@ -4,8 +4,8 @@
 //! Why not obvhs's own traversal: its CWBVH node stores 8-bit child planes that every visit
 //! decodes, and it tests them four at a time with SSE2. On the rays of the form-factor stage
 //! that ran at 0.44–0.85x Embree per core (docs/radiosity.md); this layout (Embree's BVH8 idea:
-//! boxes stored as 6 × 8 floats, a child's entry distance from one subtract and one multiply
-//! per plane) is what `benches/visibility_embree.rs` measures against it.
+//! boxes stored as 6 × 8 floats, a child's entry distance from one fused multiply-subtract per
+//! plane) is what `benches/visibility_embree.rs` measures against it.
 //!
 //! The tree's *shape* is obvhs's: [`WideBvh::from_cwbvh`] keeps every node, child slot and leaf
 //! of a [`CwBvh`] (its PLOC build and reinsertion optimiser make the tree quality that matters
@@ -13,8 +13,7 @@
 //! from the primitives' own boxes.
 //!
 //! Preconditions: primitive boxes are finite. The traversal is conservative: a child box is
-//! entered whenever the exact ray meets it (Ize, "Robust BVH ray traversal", JCGT 2013: the
-//! far distance is scaled up by 1 + 2γ₃ to cover the rounding of `(b − o) · (1/d)`), so a leaf
+//! entered whenever the exact ray meets it (the rounding argument is at [`BoxRay`]), so a leaf
 //! test that hits a primitive in exact arithmetic is always reached.
 
 use obvhs::cwbvh::CwBvh;
