@@ -119,8 +119,8 @@ impl TriangleBlocks {
         std::array::from_fn(|i| Vec3A::new(b.v[i][0][k], b.v[i][1][k], b.v[i][2][k]))
     }
 
-    /// The distances of [`Watertight::intersect`] to the triangles of block `block` (lanes
-    /// `count..` are left out: infinity).
+    /// The distances of [`Watertight::intersect`] to the first `count` triangles of block
+    /// `block` (lanes `count..` hold unused values).
     #[inline(always)]
     pub fn intersect4(
         &self,
@@ -220,12 +220,6 @@ impl TriangleBlocks {
             _mm_cmpeq_ps(w, zero),
         );
         let mut redo = _mm_movemask_ps(edge) as u32 & lanes;
-        let skip = !lanes & 0xf;
-        for (k, x) in out.iter_mut().enumerate() {
-            if skip & (1 << k) != 0 {
-                *x = f32::INFINITY;
-            }
-        }
         while redo != 0 {
             let k = redo.trailing_zeros() as usize;
             redo &= redo - 1;

@@ -35,6 +35,30 @@ struct Node {
     child: [u32; 8],
 }
 
+impl Node {
+    /// Eight empty slots.
+    const EMPTY: Node = Node {
+        planes: [
+            [f32::INFINITY; 8],
+            [f32::INFINITY; 8],
+            [f32::INFINITY; 8],
+            [f32::NEG_INFINITY; 8],
+            [f32::NEG_INFINITY; 8],
+            [f32::NEG_INFINITY; 8],
+        ],
+        child: [EMPTY; 8],
+    };
+
+    /// Put the box `lo..hi` with reference `child` into `slot`.
+    fn set(&mut self, slot: usize, (lo, hi): ([f32; 3], [f32; 3]), child: u32) {
+        for k in 0..3 {
+            self.planes[k][slot] = lo[k];
+            self.planes[3 + k][slot] = hi[k];
+        }
+        self.child[slot] = child;
+    }
+}
+
 /// The tree. Leaf tests get a leaf's number; [`WideBvh::leaves`] maps it to its primitives.
 pub struct WideBvh {
     nodes: Vec<Node>,
@@ -134,20 +158,7 @@ impl WideBvh {
                 margin: 0.0,
             };
         }
-        let mut nodes = vec![
-            Node {
-                planes: [
-                    [f32::INFINITY; 8],
-                    [f32::INFINITY; 8],
-                    [f32::INFINITY; 8],
-                    [f32::NEG_INFINITY; 8],
-                    [f32::NEG_INFINITY; 8],
-                    [f32::NEG_INFINITY; 8]
-                ],
-                child: [EMPTY; 8],
-            };
-            bvh.nodes.len()
-        ];
+        let mut nodes = vec![Node::EMPTY; bvh.nodes.len()];
         let mut leaves = Vec::new();
         let (lo, hi) = refit(bvh, 0, &prim_box, &mut nodes, &mut leaves);
         let largest = lo.iter().chain(&hi).fold(0.0f32, |m, x| m.max(x.abs()));
@@ -398,12 +409,7 @@ fn refit(
             leaves.push((first, count));
             (LEAF | id << 3 | count, b)
         };
-        let node = &mut nodes[index];
-        for k in 0..3 {
-            node.planes[k][slot] = lo[k];
-            node.planes[3 + k][slot] = hi[k];
-        }
-        node.child[slot] = child;
+        nodes[index].set(slot, (lo, hi), child);
         whole = union(whole, (lo, hi));
     }
     whole
@@ -500,22 +506,9 @@ mod tests {
     use proptest::prelude::*;
 
     fn node(boxes: &[([f32; 3], [f32; 3])]) -> Node {
-        let mut n = Node {
-            planes: [
-                [f32::INFINITY; 8],
-                [f32::INFINITY; 8],
-                [f32::INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-                [f32::NEG_INFINITY; 8],
-            ],
-            child: [EMPTY; 8],
-        };
-        for (k, (lo, hi)) in boxes.iter().enumerate() {
-            for a in 0..3 {
-                n.planes[a][k] = lo[a];
-                n.planes[3 + a][k] = hi[a];
-            }
+        let mut n = Node::EMPTY;
+        for (k, b) in boxes.iter().enumerate() {
+            n.set(k, *b, k as u32);
         }
         n
     }
