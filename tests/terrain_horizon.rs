@@ -43,6 +43,40 @@ proptest! {
     }
 }
 
+proptest! {
+    // Maps wide and tall enough that whole bundles of lines (8 adjacent columns) have every
+    // stencil tap on the map: the SIMD path, not only the border one.
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    #[test]
+    fn sweep_equals_exact_on_maps_wider_than_the_bundles(
+        w in 40usize..110, h in 40usize..100, seed in any::<u64>(),
+        k in 0usize..64, curved in any::<bool>(),
+    ) {
+        let cell = [30.0, 30.0];
+        let map = random_map(w, h, seed, cell, 20.0);
+        let dir = directions(64, cell)[k];
+        if curved {
+            // Against the brute force of the same parabola (the drop grows the slopes' size).
+            let radius = 2.0e5;
+            let sweep = horizon_sweep(&map, &dir, Some(radius));
+            let flat = horizon_sweep(&map, &dir, None);
+            let mut e = 0.0f64;
+            for row in 0..h {
+                for col in 0..w {
+                    let exact = parabolic_exact(&map, &dir, col, row, radius);
+                    e = e.max((exact - sweep[row * w + col] as f64).abs());
+                }
+            }
+            prop_assert!(e < 2e-5, "{w}x{h} dir {dir:?}: {e}°");
+            // The drop only lowers horizons.
+            prop_assert!(sweep.iter().zip(&flat).all(|(c, f)| *c <= f + 2e-5));
+        } else {
+            let e = worst(&map, &dir);
+            prop_assert!(e < 2e-5, "{w}x{h} dir {dir:?}: {e}°");
+        }
+    }
+}
+
 #[test]
 fn directions_are_near_uniform_and_distinct() {
     for n in [4usize, 8, 16, 64, 128] {

@@ -39,8 +39,6 @@
 use super::exact_traversal::{texel_sample, TrackWalk};
 use super::sun::{Track, TrackKind};
 use crate::heightmap::HeightMap;
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A horizon direction: a texel step (a columns east, b rows south) and its world azimuth.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -189,15 +187,15 @@ pub fn horizon_exact_curved(
 
 /// One texel of the period: offset from the pixel and transit times from its centre.
 #[derive(Clone, Copy, Debug)]
-struct PeriodTexel {
-    dx: i64,
-    dy: i64,
-    t_in: f64,
-    t_out: f64,
+pub(super) struct PeriodTexel {
+    pub dx: i64,
+    pub dy: i64,
+    pub t_in: f64,
+    pub t_out: f64,
 }
 
 /// The walk from a pixel centre through its period, plus the texel of P′ = P + (a, b) (last).
-fn period(track: &Track, dir: &Direction) -> Vec<PeriodTexel> {
+pub(super) fn period(track: &Track, dir: &Direction) -> Vec<PeriodTexel> {
     let (px, py) = (0.5, 0.5);
     let (mut ix, mut iy) = (0i64, 0i64);
     let mut t_in = 0.0;
@@ -230,105 +228,71 @@ fn period(track: &Track, dir: &Direction) -> Vec<PeriodTexel> {
 /// planet of radius `planet_radius` metres when given (a sample d metres away drops by
 /// d²/(2R), the parabolic approximation of the sphere: see the module notes).
 pub fn horizon_sweep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
-    let (w, h) = (map.width as i64, map.height as i64);
+    Sweeper::new(map).sweep(dir, planet_radius)
+}
+
+/// The line sweep of one map for any number of directions: it keeps the map's transpose, made
+/// once on first need, for the directions nearer the x axis than the y axis (the bundles of
+/// [`super::horizon_bundle`] need |b| ≥ |a|: their lanes are adjacent columns).
+pub struct Sweeper<'a> {
+    map: &'a HeightMap,
+    transposed: std::sync::OnceLock<HeightMap>,
+}
+
+impl<'a> Sweeper<'a> {
+    pub fn new(map: &'a HeightMap) -> Self {
+        Sweeper {
+            map,
+            transposed: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// [`horizon_sweep`] along `dir`.
+    pub fn sweep(&self, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
+        if dir.a.abs() <= dir.b.abs() {
+            return sweep_steep(self.map, dir, planet_radius);
+        }
+        let map = self.map;
+        let t = self.transposed.get_or_init(|| HeightMap {
+            width: map.height,
+            height: map.width,
+            heights: super::sweep_bound::transpose(&map.heights, map.width, map.height),
+            cell_size: [map.cell_size[1], map.cell_size[0]],
+            height_scale: map.height_scale,
+        });
+        // The mirrored direction on the mirrored map: the same tracks, x and y swapped.
+        let mirrored = Direction {
+            a: dir.b,
+            b: dir.a,
+            azimuth_deg: dir.azimuth_deg,
+        };
+        let out = sweep_steep(t, &mirrored, planet_radius);
+        super::sweep_bound::transpose(&out, t.width, t.height)
+    }
+}
+
+/// The sweep for |b| ≥ |a| on `map` itself.
+fn sweep_steep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
     let track = dir.track(map.cell_size);
     let per = period(&track, dir);
-    let k = per.len() - 1; // texels before P′'s; per[k] is P′'s texel seen from P
-                           // Line length in t: P′'s centre is at t = |(a, b)| (u is (a, b) normalised).
-    let period_t = (dir.a as f64).hypot(dir.b as f64);
     // The drop of a sample Δt away: κ·Δt² (t units: metres_per_t metres).
     let kappa = planet_radius.map_or(0.0, |r| track.metres_per_t.powi(2) / (2.0 * r));
-    let out: Vec<AtomicU32> = (0..(w * h) as usize).map(|_| AtomicU32::new(0)).collect();
-    // Line starts: pixels P with P − (a, b) off the map.
-    let starts: Vec<(i64, i64)> = (0..h)
-        .flat_map(|r| (0..w).map(move |c| (c, r)))
-        .filter(|&(c, r)| {
-            let (c0, r0) = (c - dir.a, r - dir.b);
-            c0 < 0 || r0 < 0 || c0 >= w || r0 >= h
-        })
-        .collect();
-    let inside = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h;
     let stencils = Stencils::new(&track, dir, &per);
-    starts.par_chunks(256).for_each(|chunk| {
-        let mut hull: Vec<(f64, f64)> = Vec::new();
-        let mut line: Vec<(i64, i64)> = Vec::new();
-        for &(c0, r0) in chunk {
-            line.clear();
-            let (mut c, mut r) = (c0, r0);
-            while inside(c, r) {
-                line.push((c, r));
-                c += dir.a;
-                r += dir.b;
-            }
-            hull.clear();
-            for (n, &(c, r)) in line.iter().enumerate().rev() {
-                let tau = n as f64 * period_t;
-                let zp = map.heights[(r * w + c) as usize] as f64;
-                // Heights on the line's parabola: f(τ) = h − κτ² (module notes).
-                let f = |ts: f64, hs: f64| (ts, hs - kappa * ts * ts);
-                // Push the period's samples (decreasing τ) before P's query, the own texel
-                // crossed in full (≈ P itself) after it.
-                let (own, full) = if stencils.fits(c, r, w, h) {
-                    // Interior: the period's bilinear stencils, the same for every pixel.
-                    let base = (r * w + c) as isize;
-                    let hs = &map.heights;
-                    for st in stencils.period.iter().rev() {
-                        push(&mut hull, f(tau + st.t, st.eval(hs, base, w as isize)));
-                    }
-                    let own = (stencils.own.t, stencils.own.eval(hs, base, w as isize));
-                    (
-                        own,
-                        f(
-                            tau + stencils.full.t,
-                            stencils.full.eval(hs, base, w as isize),
-                        ),
-                    )
-                } else {
-                    let p = [c as f64 + 0.5, r as f64 + 0.5];
-                    // The period texels on the map (the walk stops at the edge).
-                    let on = per[1..k]
-                        .iter()
-                        .take_while(|t| inside(c + t.dx, r + t.dy))
-                        .count();
-                    for t in per[1..=on].iter().rev() {
-                        let (x, y) = (c + t.dx, r + t.dy);
-                        let (tm, hq) = texel_sample(map, &track, p, [x, y], t.t_in, t.t_out);
-                        push(&mut hull, f(tau + tm, hq));
-                    }
-                    let own = texel_sample(map, &track, p, [c, r], 0.0, per[0].t_out);
-                    let last = per[k];
-                    let prev = [p[0] - dir.a as f64, p[1] - dir.b as f64];
-                    let (tm, hq) = texel_sample(map, &track, prev, [c, r], last.t_in, last.t_out);
-                    (own, f(tau - period_t + tm, hq))
-                };
-                // The own texel's half transit, then the tangent to everything beyond it.
-                let mut best = (own.1 - kappa * own.0 * own.0 - zp) / own.0;
-                if let Some(s) = tangent(&mut hull, tau, zp - kappa * tau * tau) {
-                    best = best.max(s + 2.0 * kappa * tau);
-                }
-                let deg = (best / track.metres_per_t).atan().to_degrees() as f32;
-                out[(r * w + c) as usize].store(deg.to_bits(), Ordering::Relaxed);
-                push(&mut hull, full);
-            }
-        }
-    });
-    out.into_iter()
-        .map(|v| f32::from_bits(v.into_inner()))
-        .collect()
+    super::horizon_bundle::sweep_bundles(map, dir, &per, &stencils, kappa)
 }
 
 /// A bilinear sample at a fixed offset from a pixel: what [`texel_sample`] computes for every
 /// pixel away from the border (the transit times and the sample's fraction within its cell
 /// are translation invariant: event times are (boundary − p)·(1/u) with boundary − p exact).
 #[derive(Clone, Copy, Debug)]
-struct Stencil {
+pub(super) struct Stencil {
     /// The cell's top-left texel relative to the pixel.
-    dx: i64,
-    dy: i64,
-    tx: f64,
-    ty: f64,
+    pub dx: i64,
+    pub dy: i64,
+    pub tx: f64,
+    pub ty: f64,
     /// The sample's t from the pixel's centre.
-    t: f64,
+    pub t: f64,
 }
 
 impl Stencil {
@@ -350,7 +314,7 @@ impl Stencil {
     }
 
     #[inline]
-    fn eval(&self, hs: &[f32], base: isize, w: isize) -> f64 {
+    pub(super) fn eval(&self, hs: &[f32], base: isize, w: isize) -> f64 {
         let i = (base + self.dy as isize * w + self.dx as isize) as usize;
         let (a, b) = (hs[i] as f64, hs[i + 1] as f64);
         let (c, d) = (hs[i + w as usize] as f64, hs[i + w as usize + 1] as f64);
@@ -364,17 +328,17 @@ impl Stencil {
 /// The stencils of a direction's period: the own texel's half transit, the rest of the
 /// period, and the own texel's full transit seen from the previous pixel (t relative to this
 /// pixel's centre); with the box of texels they read.
-struct Stencils {
-    own: Stencil,
-    period: Vec<Stencil>,
-    full: Stencil,
+pub(super) struct Stencils {
+    pub own: Stencil,
+    pub period: Vec<Stencil>,
+    pub full: Stencil,
     /// Reads texels (x + lo[0] ..= x + hi[0], y + lo[1] ..= y + hi[1]).
-    lo: [i64; 2],
-    hi: [i64; 2],
+    pub lo: [i64; 2],
+    pub hi: [i64; 2],
 }
 
 impl Stencils {
-    fn new(track: &Track, dir: &Direction, per: &[PeriodTexel]) -> Stencils {
+    pub(super) fn new(track: &Track, dir: &Direction, per: &[PeriodTexel]) -> Stencils {
         let k = per.len() - 1;
         let c = [0.5, 0.5];
         let own = Stencil::new(track, c, [0, 0], 0.0, per[0].t_out, 0.0);
@@ -403,37 +367,4 @@ impl Stencils {
             hi,
         }
     }
-
-    /// Do all stencils of pixel (c, r) lie inside a w×h map (so no border clamping applies)?
-    fn fits(&self, c: i64, r: i64, w: i64, h: i64) -> bool {
-        c + self.lo[0] >= 0 && r + self.lo[1] >= 0 && c + self.hi[0] < w && r + self.hi[1] < h
-    }
-}
-
-/// Push a point left of every hull point onto the upper hull (the last element is leftmost).
-fn push(hull: &mut Vec<(f64, f64)>, q: (f64, f64)) {
-    while hull.len() >= 2 {
-        let a = hull[hull.len() - 1];
-        let b = hull[hull.len() - 2];
-        // a is not above the segment q–b: it can never be a tangent point from the left.
-        if (a.1 - q.1) * (b.0 - q.0) <= (b.1 - q.1) * (a.0 - q.0) {
-            hull.pop();
-        } else {
-            break;
-        }
-    }
-    hull.push(q);
-}
-
-/// The steepest slope from (tau, z) to the hull's vertices (all to its right), None for an
-/// empty hull. Pops the vertices before the tangent point: the caller then pushes a point at
-/// (tau, z) (to rounding), under whose chord to the tangent point they lie, so no later query
-/// from further left can need them (Timonen & Westerholm's amortised O(1) per query).
-fn tangent(hull: &mut Vec<(f64, f64)>, tau: f64, z: f64) -> Option<f64> {
-    let slope = |q: (f64, f64)| (q.1 - z) / (q.0 - tau);
-    // The last vertex is leftmost; slopes rise from it to the tangent point, then fall.
-    while hull.len() >= 2 && slope(hull[hull.len() - 1]) <= slope(hull[hull.len() - 2]) {
-        hull.pop();
-    }
-    hull.last().map(|&q| slope(q))
 }

@@ -26,6 +26,8 @@ pub mod exact_traversal;
 pub mod generate;
 pub mod hard_f32;
 pub mod horizon;
+mod horizon_bundle;
+mod horizon_hull;
 pub mod horizon_map;
 pub use crate::heightmap::minmax_mipmap;
 pub mod relief;

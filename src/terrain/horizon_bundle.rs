@@ -1,0 +1,450 @@
+//! The horizon line sweep of [`super::horizon`] on bundles of [`LANES`] adjacent lines walked
+//! in lock-step (docs/algorithms.md §4.4).
+//!
+//! **Precondition:** a direction (a, b) with |b| ≥ |a| (so b ≠ 0); the caller transposes the
+//! map for the others ([`super::horizon::Sweeper`]).
+//!
+//! **Why bundles.** The line through pixel (c + 1, r) is the line through (c, r) moved one
+//! column: the same periods and stencils, one texel to the right. [`LANES`] such lines walked
+//! from their far ends at once visit the same rows at adjacent columns, so one contiguous load
+//! per stencil tap serves every lane (AVX2: four f64 lanes per instruction, bit for bit the
+//! scalar stencil's operations), and each cache line of the map is fetched once per bundle
+//! rather than once per line. Each lane keeps its own hull; the answer of every pixel is the
+//! one-line sweep's, operation for operation.
+//!
+//! **Virtual lines.** Pixel n of lane j is (x₀ + j + n·a, r₀ + n·b), r₀ one of the first |b|
+//! rows on the side the walk ends at, n from the far end down to 0. x₀ runs over every column
+//! whose line meets the map (also columns left or right of it, for slanted lines), so every
+//! pixel is on exactly one lane; a lane is active while its pixel is on the map, which happens
+//! over one interval of n, so a lane's hull starts empty and is never reset.
+
+use super::exact_traversal::texel_sample;
+use super::horizon::{Direction, PeriodTexel, Stencil, Stencils};
+use super::horizon_hull::Hulls;
+use super::sun::Track;
+use crate::heightmap::HeightMap;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// Lines per bundle.
+pub const LANES: usize = 8;
+
+/// What every bundle of one direction shares.
+struct Plan<'a> {
+    map: &'a HeightMap,
+    track: Track,
+    dir: Direction,
+    per: &'a [PeriodTexel],
+    stencils: &'a Stencils,
+    /// The period stencils' t from the pixel.
+    ts: Vec<f64>,
+    period_t: f64,
+    kappa: f64,
+    avx2: bool,
+}
+
+/// How a lane's samples were found at the current pixel.
+#[derive(Clone, Copy, PartialEq)]
+enum Mode {
+    /// Off the map: no pixel.
+    Off,
+    /// The stencils (every tap on the map): heights in `Lanes::heights`.
+    Stencil,
+    /// Near the border: the walk's own samples in `Lanes::border`.
+    Border,
+}
+
+/// One worker's scratch: a hull per lane and the samples of the current pixel.
+struct Lanes {
+    hulls: Hulls,
+    mode: [Mode; LANES],
+    /// Stencil mode: the period's heights, [stencil][lane], and the own texel's half and full
+    /// transits.
+    heights: Vec<[f64; LANES]>,
+    own: [f64; LANES],
+    full: [f64; LANES],
+    /// Border mode, per lane: (t from the pixel, height) of the period's samples on the map
+    /// in push order (decreasing t), the own half transit and the full one.
+    border: [Vec<(f64, f64)>; LANES],
+    border_own: [(f64, f64); LANES],
+    border_full: [(f64, f64); LANES],
+}
+
+impl Lanes {
+    fn new(period: usize) -> Lanes {
+        Lanes {
+            hulls: Hulls::new(),
+            mode: [Mode::Off; LANES],
+            heights: vec![[0.0; LANES]; period],
+            own: [0.0; LANES],
+            full: [0.0; LANES],
+            border: std::array::from_fn(|_| Vec::new()),
+            border_own: [(0.0, 0.0); LANES],
+            border_full: [(0.0, 0.0); LANES],
+        }
+    }
+}
+
+/// Horizon angles (degrees, row-major) of every pixel of `map` along `dir` (|b| ≥ |a|): the
+/// per-line sweep of [`super::horizon`], on bundles.
+pub(super) fn sweep_bundles(
+    map: &HeightMap,
+    dir: &Direction,
+    per: &[PeriodTexel],
+    stencils: &Stencils,
+    kappa: f64,
+) -> Vec<f32> {
+    sweep_bundles_with(map, dir, per, stencils, kappa, detect_avx2())
+}
+
+/// [`sweep_bundles`] with the AVX2 kernels on or off (they give the same bits).
+fn sweep_bundles_with(
+    map: &HeightMap,
+    dir: &Direction,
+    per: &[PeriodTexel],
+    stencils: &Stencils,
+    kappa: f64,
+    avx2: bool,
+) -> Vec<f32> {
+    assert!(dir.b != 0 && dir.a.abs() <= dir.b.abs());
+    let (w, h) = (map.width as i64, map.height as i64);
+    let plan = Plan {
+        map,
+        track: dir.track(map.cell_size),
+        dir: *dir,
+        per,
+        stencils,
+        ts: stencils.period.iter().map(|s| s.t).collect(),
+        period_t: (dir.a as f64).hypot(dir.b as f64),
+        kappa,
+        avx2,
+    };
+    let (a, b) = (dir.a, dir.b);
+    // The first rows of the lines (n = 0), on the side the walk ends at.
+    let band = if b > 0 {
+        0..b.min(h)
+    } else {
+        (h + b).max(0)..h
+    };
+    let mut bundles = Vec::new();
+    for r0 in band {
+        let n_max = if b > 0 { (h - 1 - r0) / b } else { r0 / -b };
+        let (lo, hi) = if a >= 0 {
+            (-n_max * a, w - 1)
+        } else {
+            (0, w - 1 - n_max * a)
+        };
+        for x0 in (lo..=hi).step_by(LANES) {
+            if let Some((n0, n1)) = active_span(x0, a, w, n_max) {
+                bundles.push((r0, x0, n0, n1));
+            }
+        }
+    }
+    let out: Vec<AtomicU32> = (0..(w * h) as usize).map(|_| AtomicU32::new(0)).collect();
+    let k = per.len() - 1;
+    bundles.par_chunks(8).for_each_init(
+        || Lanes::new(k - 1),
+        |lanes, chunk| {
+            for &(r0, x0, n0, n1) in chunk {
+                bundle(&plan, lanes, (r0, x0), (n0, n1), &out);
+            }
+        },
+    );
+    out.into_iter()
+        .map(|v| f32::from_bits(v.into_inner()))
+        .collect()
+}
+
+/// The steps n ∈ [0, n_max] at which some lane of the bundle at column x₀ is on the map
+/// (0 ≤ x₀ + j + n·a < w for some j < LANES), or None.
+fn active_span(x0: i64, a: i64, w: i64, n_max: i64) -> Option<(i64, i64)> {
+    // n·a must lie in [lo, hi].
+    let (lo, hi) = (-(LANES as i64 - 1) - x0, w - 1 - x0);
+    let (n0, n1) = match a.signum() {
+        0 if lo <= 0 && 0 <= hi => (0, n_max),
+        0 => return None,
+        1 => (ceil_div(lo, a), hi.div_euclid(a)),
+        _ => (ceil_div(-hi, -a), (-lo).div_euclid(-a)),
+    };
+    let (n0, n1) = (n0.max(0), n1.min(n_max));
+    (n0 <= n1).then_some((n0, n1))
+}
+
+/// ⌈p / q⌉ for q > 0.
+fn ceil_div(p: i64, q: i64) -> i64 {
+    -(-p).div_euclid(q)
+}
+
+/// Walk one bundle from step n1 down to n0: samples for every lane (all lanes' stencils at
+/// once where they all fit), then each lane's hull query, as the one-line sweep does.
+fn bundle(
+    plan: &Plan,
+    lanes: &mut Lanes,
+    (r0, x0): (i64, i64),
+    (n0, n1): (i64, i64),
+    out: &[AtomicU32],
+) {
+    let map = plan.map;
+    let (w, h) = (map.width as i64, map.height as i64);
+    let (st, hs, kappa) = (plan.stencils, &map.heights, plan.kappa);
+    // Every step pushes at most the period's samples and the full transit.
+    lanes
+        .hulls
+        .reset((n1 - n0 + 1) as usize * (plan.per.len() - 1) + 1);
+    // Heights on the line's parabola: f(τ) = h − κτ² (module notes of `horizon`).
+    let f = |ts: f64, hq: f64| (ts, hq - kappa * ts * ts);
+    for n in (n0..=n1).rev() {
+        let r = r0 + n * plan.dir.b;
+        let c0 = x0 + n * plan.dir.a;
+        let tau = n as f64 * plan.period_t;
+        let rows_fit = r + st.lo[1] >= 0 && r + st.hi[1] < h;
+        let all_fit = rows_fit && c0 + st.lo[0] >= 0 && c0 + LANES as i64 - 1 + st.hi[0] < w;
+        // The own texel's half transit, then the tangent to everything beyond it.
+        let finish = |j: usize, own: (f64, f64), s: f64| {
+            let pixel = (r * w + c0 + j as i64) as usize;
+            let zp = hs[pixel] as f64;
+            let mut best = (own.1 - kappa * own.0 * own.0 - zp) / own.0;
+            if s > f64::NEG_INFINITY {
+                best = best.max(s + 2.0 * kappa * tau);
+            }
+            let deg = (best / plan.track.metres_per_t).atan().to_degrees() as f32;
+            out[pixel].store(deg.to_bits(), Ordering::Relaxed);
+        };
+        if all_fit {
+            let first = (r * w + c0) as usize;
+            eval_lanes(plan, first, lanes);
+            #[cfg(target_arch = "x86_64")]
+            if plan.avx2 {
+                for g in 0..LANES / 4 {
+                    let z =
+                        std::array::from_fn(|l| hs[first + 4 * g + l] as f64 - kappa * tau * tau);
+                    let full = (st.full.t, &lanes.full);
+                    // SAFETY: AVX2 was detected; `reset` left room for every push.
+                    let s = unsafe {
+                        lanes
+                            .hulls
+                            .step_avx2(g, &plan.ts, &lanes.heights, full, tau, kappa, z)
+                    };
+                    for (l, &s) in s.iter().enumerate() {
+                        finish(4 * g + l, (st.own.t, lanes.own[4 * g + l]), s);
+                    }
+                }
+                continue;
+            }
+            lanes.mode = [Mode::Stencil; LANES];
+        } else {
+            for j in 0..LANES {
+                let c = c0 + j as i64;
+                lanes.mode[j] = if c < 0 || c >= w {
+                    Mode::Off
+                } else if rows_fit && c + st.lo[0] >= 0 && c + st.hi[0] < w {
+                    let base = (r * w + c) as isize;
+                    for (s, stencil) in st.period.iter().enumerate() {
+                        lanes.heights[s][j] = stencil.eval(hs, base, w as isize);
+                    }
+                    lanes.own[j] = st.own.eval(hs, base, w as isize);
+                    lanes.full[j] = st.full.eval(hs, base, w as isize);
+                    Mode::Stencil
+                } else {
+                    border_samples(plan, (c, r), j, lanes);
+                    Mode::Border
+                };
+            }
+        }
+        // One lane at a time: push the period's samples (decreasing τ) before P's query, the
+        // own texel crossed in full (≈ P itself) after it.
+        for j in 0..LANES {
+            let zp = match lanes.mode[j] {
+                Mode::Off => continue,
+                _ => hs[(r * w + c0 + j as i64) as usize] as f64,
+            };
+            let (own, full) = match lanes.mode[j] {
+                Mode::Off => continue,
+                Mode::Stencil => {
+                    for (s, &t) in plan.ts.iter().enumerate().rev() {
+                        lanes.hulls.push(j, f(tau + t, lanes.heights[s][j]));
+                    }
+                    ((st.own.t, lanes.own[j]), f(tau + st.full.t, lanes.full[j]))
+                }
+                Mode::Border => {
+                    for &(t, hq) in &lanes.border[j] {
+                        lanes.hulls.push(j, f(tau + t, hq));
+                    }
+                    let (t, hq) = lanes.border_full[j];
+                    (lanes.border_own[j], f(tau + t, hq))
+                }
+            };
+            let s = lanes.hulls.tangent(j, tau, zp - kappa * tau * tau);
+            finish(j, own, s.unwrap_or(f64::NEG_INFINITY));
+            lanes.hulls.push(j, full);
+        }
+    }
+}
+
+/// The walk's own samples of pixel (c, r) near the border, where some stencil tap is off the
+/// map: the period's texels up to the edge (the walk stops there), its own texel's half
+/// transit, and its full transit as the previous pixel's track crosses it.
+fn border_samples(plan: &Plan, (c, r): (i64, i64), j: usize, lanes: &mut Lanes) {
+    let (map, track, per) = (plan.map, &plan.track, plan.per);
+    let (w, h) = (map.width as i64, map.height as i64);
+    let inside = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h;
+    let k = per.len() - 1;
+    let p = [c as f64 + 0.5, r as f64 + 0.5];
+    let on = per[1..k]
+        .iter()
+        .take_while(|t| inside(c + t.dx, r + t.dy))
+        .count();
+    let border = &mut lanes.border[j];
+    border.clear();
+    for t in per[1..=on].iter().rev() {
+        border.push(texel_sample(
+            map,
+            track,
+            p,
+            [c + t.dx, r + t.dy],
+            t.t_in,
+            t.t_out,
+        ));
+    }
+    lanes.border_own[j] = texel_sample(map, track, p, [c, r], 0.0, per[0].t_out);
+    let last = per[k];
+    let prev = [p[0] - plan.dir.a as f64, p[1] - plan.dir.b as f64];
+    let (tm, hq) = texel_sample(map, track, prev, [c, r], last.t_in, last.t_out);
+    lanes.border_full[j] = (tm - plan.period_t, hq);
+}
+
+/// Every stencil of the lanes' pixels, lane j at `base + j` (all taps on the map).
+fn eval_lanes(plan: &Plan, base: usize, lanes: &mut Lanes) {
+    let (hs, w, st) = (&plan.map.heights[..], plan.map.width, plan.stencils);
+    #[cfg(target_arch = "x86_64")]
+    if plan.avx2 {
+        // SAFETY: AVX2 was detected; every tap of every lane is on the map (the caller's test),
+        // which is what `eval_avx2` reads.
+        unsafe {
+            for (s, stencil) in st.period.iter().enumerate() {
+                eval_avx2(stencil, hs, base, w, &mut lanes.heights[s]);
+            }
+            eval_avx2(&st.own, hs, base, w, &mut lanes.own);
+            eval_avx2(&st.full, hs, base, w, &mut lanes.full);
+        }
+        return;
+    }
+    for (s, stencil) in st.period.iter().enumerate() {
+        eval_portable(stencil, hs, base, w, &mut lanes.heights[s]);
+    }
+    eval_portable(&st.own, hs, base, w, &mut lanes.own);
+    eval_portable(&st.full, hs, base, w, &mut lanes.full);
+}
+
+/// [`Stencil::eval`] of lanes `base + j`, one at a time.
+fn eval_portable(st: &Stencil, hs: &[f32], base: usize, w: usize, out: &mut [f64; LANES]) {
+    for (j, o) in out.iter_mut().enumerate() {
+        *o = st.eval(hs, (base + j) as isize, w as isize);
+    }
+}
+
+/// [`Stencil::eval`] of lanes `base + j`, four at a time: the same operations (no FMA), so the
+/// same bits.
+///
+/// # Safety
+/// AVX2 must be available, and the taps of lanes 0..LANES (texels `base + j + dy·w + dx` up to
+/// one row and one column further) must lie in `hs`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn eval_avx2(st: &Stencil, hs: &[f32], base: usize, w: usize, out: &mut [f64; LANES]) {
+    use std::arch::x86_64::*;
+    let i = (base as isize + st.dy as isize * w as isize + st.dx as isize) as usize;
+    assert!(i + w + LANES < hs.len());
+    let (tx, ty) = (_mm256_set1_pd(st.tx), _mm256_set1_pd(st.ty));
+    for half in 0..LANES / 4 {
+        let p = hs.as_ptr().add(i + 4 * half);
+        let a = _mm256_cvtps_pd(_mm_loadu_ps(p));
+        let b = _mm256_cvtps_pd(_mm_loadu_ps(p.add(1)));
+        let c = _mm256_cvtps_pd(_mm_loadu_ps(p.add(w)));
+        let d = _mm256_cvtps_pd(_mm_loadu_ps(p.add(w + 1)));
+        let top = _mm256_add_pd(a, _mm256_mul_pd(_mm256_sub_pd(b, a), tx));
+        let bottom = _mm256_add_pd(c, _mm256_mul_pd(_mm256_sub_pd(d, c), tx));
+        let v = _mm256_add_pd(top, _mm256_mul_pd(_mm256_sub_pd(bottom, top), ty));
+        let lo = _mm256_min_pd(_mm256_min_pd(a, b), _mm256_min_pd(c, d));
+        let hi = _mm256_max_pd(_mm256_max_pd(a, b), _mm256_max_pd(c, d));
+        _mm256_storeu_pd(
+            out.as_mut_ptr().add(4 * half),
+            _mm256_min_pd(_mm256_max_pd(v, lo), hi),
+        );
+    }
+}
+
+fn detect_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::terrain::horizon::{directions, period};
+    use proptest::prelude::*;
+
+    /// A rough random map (spikes over smooth noise) from a seed.
+    fn map(w: usize, h: usize, seed: u64) -> HeightMap {
+        let mut s = seed | 1;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let heights = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32, (i / w) as f32);
+                let spike = if next() < 0.05 { 40.0 * next() } else { 0.0 };
+                10.0 * (0.3 * x).sin() * (0.2 * y).cos() + 3.0 * next() + spike + 1000.0
+            })
+            .collect();
+        HeightMap {
+            width: w,
+            height: h,
+            heights,
+            cell_size: [10.0, 10.0],
+            height_scale: 1.0,
+        }
+    }
+
+    fn sweep(map: &HeightMap, dir: &Direction, kappa: f64, avx2: bool) -> Vec<f32> {
+        let track = dir.track(map.cell_size);
+        let per = period(&track, dir);
+        let stencils = Stencils::new(&track, dir, &per);
+        sweep_bundles_with(map, dir, &per, &stencils, kappa, avx2)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+        /// The AVX2 stencils and hulls give the portable path's bits on every pixel.
+        #[test]
+        fn avx2_bundles_equal_the_portable_ones(
+            w in 8usize..90, h in 8usize..90, seed in any::<u64>(), k in 0usize..64,
+            kappa in prop::sample::select(vec![0.0, 1e-6, 0.05]),
+        ) {
+            // CI machines have AVX2 (x86-64-v3): there the comparison must run.
+            if !detect_avx2() {
+                prop_assert!(std::env::var_os("CI").is_none(), "no AVX2 on this CI machine");
+                return Ok(());
+            }
+            let m = map(w, h, seed);
+            let dirs = directions(64, m.cell_size);
+            let d = dirs[k];
+            // The steep form of the direction (the sweeper transposes the others).
+            let d = if d.a.abs() <= d.b.abs() { d } else { Direction { a: d.b, b: d.a, ..d } };
+            let fast = sweep(&m, &d, kappa, true);
+            let slow = sweep(&m, &d, kappa, false);
+            let same = fast.iter().zip(&slow).filter(|(a, b)| a.to_bits() == b.to_bits()).count();
+            prop_assert_eq!(same, w * h, "{}x{} {:?}", w, h, d);
+        }
+    }
+}
