@@ -7,7 +7,8 @@ mod terrain_common;
 
 use proptest::prelude::*;
 use relume::heightmap::HeightMap;
-use relume::terrain::horizon::{directions, horizon_exact, horizon_sweep, Direction};
+use relume::terrain::horizon::{directions, horizon_exact, Direction};
+use relume::terrain::horizon_sweep::horizon_sweep;
 use terrain_common::random_map;
 
 /// The largest |sweep − exact| in degrees over every pixel.

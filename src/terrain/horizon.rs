@@ -1,6 +1,8 @@
-//! Horizon maps (docs/algorithms.md §4.4): for each of N azimuths, the elevation angle of the
-//! horizon at every texel, by a sweep along lines through pixel centres with an upper convex
-//! hull per line (after Timonen & Westerholm 2010), equal to the exact per-pixel horizon.
+//! Horizon geometry (docs/algorithms.md §4.4): for each of N azimuths, the elevation angle of
+//! the horizon at every texel, found by a sweep along lines through pixel centres with an upper
+//! convex hull per line (after Timonen & Westerholm 2010; [`super::horizon_sweep`] runs it),
+//! equal to the exact per-pixel horizon. Here: the directions, the exact references, and the
+//! period and stencils every pixel of a direction shares.
 //!
 //! **The horizon.** For pixel P and a track direction u, the horizon angle is
 //! `H(P) = atan(max_T (h(Q_T) − z_P) / (t_T · metres_per_t))` over the texels T of P's track
@@ -222,63 +224,6 @@ pub(super) fn period(track: &Track, dir: &Direction) -> Vec<PeriodTexel> {
         t_in = t_out;
         assert!(out.len() as i64 <= 2 * (dir.a.abs() + dir.b.abs()) + 2);
     }
-}
-
-/// Horizon angles (degrees, row-major) of every pixel along `dir`, by the line sweep; on a
-/// planet of radius `planet_radius` metres when given (a sample d metres away drops by
-/// d²/(2R), the parabolic approximation of the sphere: see the module notes).
-pub fn horizon_sweep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
-    Sweeper::new(map).sweep(dir, planet_radius)
-}
-
-/// The line sweep of one map for any number of directions: it keeps the map's transpose, made
-/// once on first need, for the directions nearer the x axis than the y axis (the bundles of
-/// [`super::horizon_bundle`] need |b| ≥ |a|: their lanes are adjacent columns).
-pub struct Sweeper<'a> {
-    map: &'a HeightMap,
-    transposed: std::sync::OnceLock<HeightMap>,
-}
-
-impl<'a> Sweeper<'a> {
-    pub fn new(map: &'a HeightMap) -> Self {
-        Sweeper {
-            map,
-            transposed: std::sync::OnceLock::new(),
-        }
-    }
-
-    /// [`horizon_sweep`] along `dir`.
-    pub fn sweep(&self, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
-        if dir.a.abs() <= dir.b.abs() {
-            return sweep_steep(self.map, dir, planet_radius);
-        }
-        let map = self.map;
-        let t = self.transposed.get_or_init(|| HeightMap {
-            width: map.height,
-            height: map.width,
-            heights: super::sweep_bound::transpose(&map.heights, map.width, map.height),
-            cell_size: [map.cell_size[1], map.cell_size[0]],
-            height_scale: map.height_scale,
-        });
-        // The mirrored direction on the mirrored map: the same tracks, x and y swapped.
-        let mirrored = Direction {
-            a: dir.b,
-            b: dir.a,
-            azimuth_deg: dir.azimuth_deg,
-        };
-        let out = sweep_steep(t, &mirrored, planet_radius);
-        super::sweep_bound::transpose(&out, t.width, t.height)
-    }
-}
-
-/// The sweep for |b| ≥ |a| on `map` itself.
-fn sweep_steep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
-    let track = dir.track(map.cell_size);
-    let per = period(&track, dir);
-    // The drop of a sample Δt away: κ·Δt² (t units: metres_per_t metres).
-    let kappa = planet_radius.map_or(0.0, |r| track.metres_per_t.powi(2) / (2.0 * r));
-    let stencils = Stencils::new(&track, dir, &per);
-    super::horizon_bundle::sweep_bundles(map, dir, &per, &stencils, kappa)
 }
 
 /// A bilinear sample at a fixed offset from a pixel: what [`texel_sample`] computes for every

@@ -1,5 +1,5 @@
 //! The upper convex hulls of the horizon sweep's lines ([`super::horizon`], docs/algorithms.md
-//! §4.4), one per lane of a bundle ([`super::horizon_bundle`]): a push that keeps the hull
+//! §4.4), one per lane of a bundle ([`super::horizon_sweep`]): a push that keeps the hull
 //! upper-convex, and the tangent query from a point left of every vertex. The scalar
 //! operations serve one lane at a time; [`Hulls::step_avx2`] runs four lanes in AVX2 with the
 //! same operations in the same order (no FMA), so it gives the same bits (a proptest holds
@@ -13,7 +13,8 @@
 //! is popped while its slope from (τ, z) is at most the next one's, compared as
 //! `(y₁ − z)(x₂ − τ) ≤ (y₂ − z)(x₁ − τ)` (both x − τ > 0: no division in the loop).
 
-use super::horizon_bundle::LANES;
+/// Lines per bundle of the sweep ([`super::horizon_sweep`]): two groups of four f64 lanes.
+pub const LANES: usize = 8;
 
 /// The hulls of the lanes of one bundle.
 pub(super) struct Hulls {

@@ -1,8 +1,9 @@
-//! Horizon maps for N azimuths, quantised to u16 (built by [`super::horizon`]'s line sweep):
+//! Horizon maps for N azimuths, quantised to u16 (built by the line sweep, [`super::horizon_sweep`]):
 //! the sky-view factor, and hard shadows for any sun in O(1) per pixel by interpolating the
 //! horizon between the two stored azimuths around the sun's (docs/algorithms.md §4.4).
 
-use super::horizon::{directions, horizon_sweep, Direction};
+use super::horizon::{directions, Direction};
+use super::horizon_sweep::Sweeper;
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
 
@@ -91,10 +92,13 @@ impl HorizonMap {
     ) -> HorizonMap {
         debug_assert!((1..=360).contains(&settings.directions));
         let directions = directions(settings.directions, map.cell_size);
+        // One sweeper: the map's transpose is made once for all directions that need it.
+        let sweeper = Sweeper::new(map);
         let angles = directions
             .iter()
             .map(|d| {
-                let plane = horizon_sweep(map, d, settings.planet_radius)
+                let plane = sweeper
+                    .sweep(d, settings.planet_radius)
                     .iter()
                     .map(|&a| encode(a as f64))
                     .collect();

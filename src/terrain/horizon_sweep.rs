@@ -1,8 +1,11 @@
-//! The horizon line sweep of [`super::horizon`] on bundles of [`LANES`] adjacent lines walked
-//! in lock-step (docs/algorithms.md §4.4).
+//! The horizon line sweep: the horizon angle of every pixel along one direction, equal to the
+//! exact per-pixel horizon ([`super::horizon`] has the geometry: rational directions, periods,
+//! stencils, and the hull argument; docs/algorithms.md §4.4). Lines of pixels are walked from
+//! their far ends with an upper convex hull per line ([`super::horizon_hull`]), on bundles of
+//! [`LANES`] adjacent lines in lock-step.
 //!
-//! **Precondition:** a direction (a, b) with |b| ≥ |a| (so b ≠ 0); the caller transposes the
-//! map for the others ([`super::horizon::Sweeper`]).
+//! **Precondition of the bundles:** a direction (a, b) with |b| ≥ |a| (so b ≠ 0); [`Sweeper`]
+//! transposes the map (once) for the others and the answer back.
 //!
 //! **Why bundles.** The line through pixel (c + 1, r) is the line through (c, r) moved one
 //! column: the same periods and stencils, one texel to the right. [`LANES`] such lines walked
@@ -19,15 +22,71 @@
 //! over one interval of n, so a lane's hull starts empty and is never reset.
 
 use super::exact_traversal::texel_sample;
-use super::horizon::{Direction, PeriodTexel, Stencil, Stencils};
+use super::horizon::{period, Direction, PeriodTexel, Stencil, Stencils};
 use super::horizon_hull::Hulls;
+pub use super::horizon_hull::LANES;
 use super::sun::Track;
+use super::sweep_bound::transpose;
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-/// Lines per bundle.
-pub const LANES: usize = 8;
+/// Horizon angles (degrees, row-major) of every pixel along `dir`, by the line sweep; on a
+/// planet of radius `planet_radius` metres when given (a sample d metres away drops by
+/// d²/(2R), the parabolic approximation of the sphere: see the module notes).
+pub fn horizon_sweep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
+    Sweeper::new(map).sweep(dir, planet_radius)
+}
+
+/// The line sweep of one map for any number of directions: it keeps the map's transpose, made
+/// once on first need, for the directions nearer the x axis than the y axis (the bundles of
+/// the bundles below need |b| ≥ |a|: their lanes are adjacent columns).
+pub struct Sweeper<'a> {
+    map: &'a HeightMap,
+    transposed: std::sync::OnceLock<HeightMap>,
+}
+
+impl<'a> Sweeper<'a> {
+    pub fn new(map: &'a HeightMap) -> Self {
+        Sweeper {
+            map,
+            transposed: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// [`horizon_sweep`] along `dir`.
+    pub fn sweep(&self, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
+        if dir.a.abs() <= dir.b.abs() {
+            return sweep_steep(self.map, dir, planet_radius);
+        }
+        let map = self.map;
+        let t = self.transposed.get_or_init(|| HeightMap {
+            width: map.height,
+            height: map.width,
+            heights: transpose(&map.heights, map.width, map.height),
+            cell_size: [map.cell_size[1], map.cell_size[0]],
+            height_scale: map.height_scale,
+        });
+        // The mirrored direction on the mirrored map: the same tracks, x and y swapped.
+        let mirrored = Direction {
+            a: dir.b,
+            b: dir.a,
+            azimuth_deg: dir.azimuth_deg,
+        };
+        let out = sweep_steep(t, &mirrored, planet_radius);
+        transpose(&out, t.width, t.height)
+    }
+}
+
+/// The sweep for |b| ≥ |a| on `map` itself.
+fn sweep_steep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
+    let track = dir.track(map.cell_size);
+    let per = period(&track, dir);
+    // The drop of a sample Δt away: κ·Δt² (t units: metres_per_t metres).
+    let kappa = planet_radius.map_or(0.0, |r| track.metres_per_t.powi(2) / (2.0 * r));
+    let stencils = Stencils::new(&track, dir, &per);
+    sweep_bundles(map, dir, &per, &stencils, kappa)
+}
 
 /// What every bundle of one direction shares.
 struct Plan<'a> {
@@ -388,7 +447,7 @@ fn detect_avx2() -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::terrain::horizon::{directions, period};
+    use crate::terrain::horizon::directions;
     use proptest::prelude::*;
 
     /// A rough random map (spikes over smooth noise) from a seed.
