@@ -134,7 +134,7 @@ impl Hulls {
         // against (px, py), drop it (the next two move up, the third comes from memory).
         // Evaluates to the mask of the lanes that popped.
         macro_rules! pop_once {
-            ($px:expr, $py:expr) => {{
+            ($px:expr, $py:expr, $refill:expr) => {{
                 let l = _mm256_mul_pd(_mm256_sub_pd(t1.1, $py), _mm256_sub_pd(t2.0, $px));
                 let r = _mm256_mul_pd(_mm256_sub_pd(t2.1, $py), _mm256_sub_pd(t1.0, $px));
                 let deep = _mm256_castsi256_pd(_mm256_cmpgt_epi64(len, one));
@@ -148,18 +148,24 @@ impl Hulls {
                 };
                 t1 = blend(t1, t2);
                 t2 = blend(t2, t3);
-                t3 = blend(t3, at(len, 3));
+                if $refill {
+                    t3 = blend(t3, at(len, 3));
+                }
                 pop
             }};
         }
-        // Pop until no lane's top vertex fails: two masked rounds without a branch (most
-        // pushes pop at most twice), then a loop for the rest.
+        // Pop until no lane's top vertex fails. Two rounds without a gather or a branch (most
+        // pushes pop at most twice): after them t1 is right in every lane, t2 wherever the
+        // lane did not pop twice, t3 wherever it did not pop at all — enough for the push
+        // unless some lane popped twice; then the top two are read back from memory and the
+        // rounds go on with a gather each.
         macro_rules! pop_while {
             ($px:expr, $py:expr) => {{
-                pop_once!($px, $py);
-                let mut pop = pop_once!($px, $py);
-                while _mm256_movemask_pd(pop) != 0 {
-                    pop = pop_once!($px, $py);
+                pop_once!($px, $py, false);
+                let twice = pop_once!($px, $py, false);
+                if _mm256_movemask_pd(twice) != 0 {
+                    (t2, t3) = (at(len, 2), at(len, 3));
+                    while _mm256_movemask_pd(pop_once!($px, $py, true)) != 0 {}
                 }
             }};
         }
@@ -197,6 +203,8 @@ impl Hulls {
         // The tangent from (τ, z).
         let (tv, zv) = (_mm256_set1_pd(tau), _mm256_loadu_pd(z.as_ptr()));
         pop_while!(tv, zv);
+        // No shift follows the query: t3 is read back wherever a lane popped.
+        t3 = at(len, 3);
         let slope = _mm256_div_pd(_mm256_sub_pd(t1.1, zv), _mm256_sub_pd(t1.0, tv));
         let empty = _mm256_castsi256_pd(_mm256_cmpgt_epi64(one, len));
         let slope = _mm256_blendv_pd(slope, _mm256_set1_pd(f64::NEG_INFINITY), empty);
