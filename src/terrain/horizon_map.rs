@@ -99,7 +99,7 @@ impl HorizonMap {
             .map(|d| {
                 let plane = sweeper
                     .sweep(d, settings.planet_radius)
-                    .iter()
+                    .par_iter()
                     .map(|&a| encode(a as f64))
                     .collect();
                 progress.advance(1);
