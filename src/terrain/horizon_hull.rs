@@ -12,6 +12,8 @@
 //! **Tangent.** Slopes rise from the leftmost vertex to the tangent point, then fall; a vertex
 //! is popped while its slope from (τ, z) is at most the next one's, compared as
 //! `(y₁ − z)(x₂ − τ) ≤ (y₂ − z)(x₁ − τ)` (both x − τ > 0: no division in the loop).
+//!
+//! **Angles.** [`atan_degrees`] turns the lanes' tangents into degrees at once.
 
 /// Lines per bundle of the sweep ([`super::horizon_sweep`]): two groups of four f64 lanes.
 pub const LANES: usize = 8;
@@ -214,5 +216,109 @@ impl Hulls {
         let mut out = [0.0; 4];
         _mm256_storeu_pd(out.as_mut_ptr(), slope);
         out
+    }
+}
+
+/// atan(x) in degrees for every lane: Cephes' `atan` (S. L. Moshier; the argument reduced to
+/// |x| ≤ 0.66 by atan x = π/2 − atan(1/x) above tan(3π/8) and π/4 + atan((x − 1)/(x + 1))
+/// between, then a rational function of degree 4/5 in x²), written with selects so that the
+/// eight lanes vectorise: libm's scalar `atan` was 10 % of a horizon build. Within 2 ulp of
+/// `f64::atan` counting the round trip through degrees (the unit test), far below the f32
+/// degrees it is stored as.
+#[allow(clippy::excessive_precision)] // Cephes' constants as published
+pub(super) fn atan_degrees(x: &[f64; LANES]) -> [f64; LANES] {
+    const P: [f64; 5] = [
+        -8.750608600031904122785E-1,
+        -1.615753718733365076637E1,
+        -7.500855792314704667340E1,
+        -1.228866684490136173410E2,
+        -6.485021904942025371773E1,
+    ];
+    const Q: [f64; 5] = [
+        2.485846490142306297962E1,
+        1.650270098316988542046E2,
+        4.328810604912902668951E2,
+        4.853903996359136964868E2,
+        1.945506571482613964425E2,
+    ];
+    const T3P8: f64 = 2.414_213_562_373_095;
+    const MOREBITS: f64 = 6.123233995736765886130E-17;
+    let mut out = [0.0; LANES];
+    for (o, &v) in out.iter_mut().zip(x) {
+        let a = v.abs();
+        let big = a > T3P8;
+        let mid = !big && a > 0.66;
+        let r = if big {
+            -1.0 / a
+        } else if mid {
+            (a - 1.0) / (a + 1.0)
+        } else {
+            a
+        };
+        let base = if big {
+            std::f64::consts::FRAC_PI_2
+        } else if mid {
+            std::f64::consts::FRAC_PI_4
+        } else {
+            0.0
+        };
+        let more = if big {
+            MOREBITS
+        } else if mid {
+            0.5 * MOREBITS
+        } else {
+            0.0
+        };
+        let z = r * r;
+        let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
+        let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+        let y = base + (r * (z * p / q) + r + more);
+        *o = y.copysign(v).to_degrees();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The lanes' atan against libm's, in ulps of the radians, over every magnitude (with ±0,
+    /// the reduction's break points and ±∞).
+    #[test]
+    fn lane_atan_matches_libm_within_a_few_ulp() {
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.66,
+            -0.66,
+            2.414_213_562_373_095,
+            1.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..200_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let m = (s >> 11) as f64 / (1u64 << 53) as f64;
+            let e = ((s >> 3) % 80) as i32 - 40;
+            xs.push(if s & 1 == 0 { m } else { -m } * 2f64.powi(e));
+        }
+        let mut worst = 0.0f64;
+        for c in xs.chunks(LANES) {
+            let mut x = [0.0; LANES];
+            x[..c.len()].copy_from_slice(c);
+            let got = atan_degrees(&x);
+            for (&v, &g) in x.iter().zip(&got) {
+                let want = v.atan();
+                let ulp =
+                    (want.abs().max(f64::MIN_POSITIVE) * f64::EPSILON).max(f64::EPSILON * 1e-300);
+                worst = worst.max((g.to_radians() - want).abs() / ulp);
+                assert_eq!(g.is_sign_negative(), want.is_sign_negative(), "{v}");
+            }
+        }
+        // Measured 1.78 ulp, counting the round trip through degrees (an ulp or so each way).
+        assert!(worst <= 4.0, "worst {worst} ulp");
     }
 }
