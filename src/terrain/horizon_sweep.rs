@@ -85,7 +85,7 @@ fn sweep_steep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> 
     // The drop of a sample Δt away: κ·Δt² (t units: metres_per_t metres).
     let kappa = planet_radius.map_or(0.0, |r| track.metres_per_t.powi(2) / (2.0 * r));
     let stencils = Stencils::new(&track, dir, &per);
-    sweep_bundles(map, dir, &per, &stencils, kappa)
+    sweep_bundles(map, (dir, &track), &per, &stencils, kappa)
 }
 
 /// What every bundle of one direction shares.
@@ -148,7 +148,7 @@ impl Lanes {
 /// per-line sweep of [`super::horizon`], on bundles.
 pub(super) fn sweep_bundles(
     map: &HeightMap,
-    dir: &Direction,
+    dir: (&Direction, &Track),
     per: &[PeriodTexel],
     stencils: &Stencils,
     kappa: f64,
@@ -159,7 +159,7 @@ pub(super) fn sweep_bundles(
 /// [`sweep_bundles`] with the AVX2 kernels on or off (they give the same bits).
 fn sweep_bundles_with(
     map: &HeightMap,
-    dir: &Direction,
+    (dir, track): (&Direction, &Track),
     per: &[PeriodTexel],
     stencils: &Stencils,
     kappa: f64,
@@ -169,7 +169,7 @@ fn sweep_bundles_with(
     let (w, h) = (map.width as i64, map.height as i64);
     let plan = Plan {
         map,
-        track: dir.track(map.cell_size),
+        track: *track,
         dir: *dir,
         per,
         stencils,
@@ -258,7 +258,6 @@ fn bundle(
         let tau = n as f64 * plan.period_t;
         let rows_fit = r + st.lo[1] >= 0 && r + st.hi[1] < h;
         let all_fit = rows_fit && c0 + st.lo[0] >= 0 && c0 + LANES as i64 - 1 + st.hi[0] < w;
-        // The own texel's half transit, then the tangent to everything beyond it.
         // The own texel's half transit, then the tangent to everything beyond it: the
         // horizon's tangent for lane j, in `slopes[j]`.
         let mut slopes = [f64::NAN; LANES];
@@ -299,12 +298,7 @@ fn bundle(
                 lanes.mode[j] = if c < 0 || c >= w {
                     Mode::Off
                 } else if rows_fit && c + st.lo[0] >= 0 && c + st.hi[0] < w {
-                    let base = (r * w + c) as isize;
-                    for (s, stencil) in st.period.iter().enumerate() {
-                        lanes.heights[s][j] = stencil.eval(hs, base, w as isize);
-                    }
-                    lanes.own[j] = st.own.eval(hs, base, w as isize);
-                    lanes.full[j] = st.full.eval(hs, base, w as isize);
+                    eval_lane(plan, (r * w + c) as usize, j, lanes);
                     Mode::Stencil
                 } else {
                     border_samples(plan, (c, r), j, lanes);
@@ -315,10 +309,6 @@ fn bundle(
         // One lane at a time: push the period's samples (decreasing τ) before P's query, the
         // own texel crossed in full (≈ P itself) after it.
         for j in 0..LANES {
-            let zp = match lanes.mode[j] {
-                Mode::Off => continue,
-                _ => hs[(r * w + c0 + j as i64) as usize] as f64,
-            };
             let (own, full) = match lanes.mode[j] {
                 Mode::Off => continue,
                 Mode::Stencil => {
@@ -335,6 +325,7 @@ fn bundle(
                     (lanes.border_own[j], f(tau + t, hq))
                 }
             };
+            let zp = hs[(r * w + c0 + j as i64) as usize] as f64;
             let s = lanes.hulls.tangent(j, tau, zp - kappa * tau * tau);
             finish(j, own, s.unwrap_or(f64::NEG_INFINITY));
             lanes.hulls.push(j, full);
@@ -402,18 +393,24 @@ fn eval_lanes(plan: &Plan, base: usize, lanes: &mut Lanes) {
         }
         return;
     }
-    for (s, stencil) in st.period.iter().enumerate() {
-        eval_portable(stencil, hs, base, w, &mut lanes.heights[s]);
+    for j in 0..LANES {
+        eval_lane(plan, base + j, j, lanes);
     }
-    eval_portable(&st.own, hs, base, w, &mut lanes.own);
-    eval_portable(&st.full, hs, base, w, &mut lanes.full);
 }
 
-/// [`Stencil::eval`] of lanes `base + j`, one at a time.
-fn eval_portable(st: &Stencil, hs: &[f32], base: usize, w: usize, out: &mut [f64; LANES]) {
-    for (j, o) in out.iter_mut().enumerate() {
-        *o = st.eval(hs, (base + j) as isize, w as isize);
+/// Every stencil of lane j's pixel at `pixel` (all its taps on the map), by [`Stencil::eval`].
+fn eval_lane(plan: &Plan, pixel: usize, j: usize, lanes: &mut Lanes) {
+    let (hs, w, st) = (
+        &plan.map.heights[..],
+        plan.map.width as isize,
+        plan.stencils,
+    );
+    let base = pixel as isize;
+    for (s, stencil) in st.period.iter().enumerate() {
+        lanes.heights[s][j] = stencil.eval(hs, base, w);
     }
+    lanes.own[j] = st.own.eval(hs, base, w);
+    lanes.full[j] = st.full.eval(hs, base, w);
 }
 
 /// [`Stencil::eval`] of lanes `base + j`, four at a time: the same operations (no FMA), so the
@@ -493,7 +490,7 @@ mod tests {
         let track = dir.track(map.cell_size);
         let per = period(&track, dir);
         let stencils = Stencils::new(&track, dir, &per);
-        sweep_bundles_with(map, dir, &per, &stencils, kappa, avx2)
+        sweep_bundles_with(map, (dir, &track), &per, &stencils, kappa, avx2)
     }
 
     proptest! {
