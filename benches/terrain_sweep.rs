@@ -6,7 +6,8 @@
 //! on every pixel, tests/terrain_exactness.rs) and, at 1K, from the exact traversal itself.
 //!
 //! `cargo bench --bench terrain_sweep` (env: RELUME_BENCH_SIZES, e.g. "1024,4096";
-//! RELUME_BENCH_AZIMUTH, default 300; RELUME_BENCH_ELEVATIONS, default "2,5,10,30,60").
+//! RELUME_BENCH_AZIMUTH, default 300; RELUME_BENCH_ELEVATIONS, default "2,5,10,30,60";
+//! RELUME_BENCH_A2=0 skips the traversal and the comparisons, for profiling the sweep alone).
 
 use rayon::prelude::*;
 use relume::terrain::relief::{shadow_mask, HardMethod};
@@ -36,6 +37,7 @@ fn main() {
     let az: f64 = env("RELUME_BENCH_AZIMUTH", 300.0);
     let sizes = env_list::<f64>("RELUME_BENCH_SIZES", "1024,2048,4096");
     let elevations = env_list::<f64>("RELUME_BENCH_ELEVATIONS", "2,5,10,30,60");
+    let with_a2 = env("RELUME_BENCH_A2", 1u32) != 0;
     println!("## Hard shadows: certified sweep vs the read floor, Puget Sound, azimuth {az}°\n");
     println!(
         "{} threads; wall times, best of 3 (floor: best of 5); shared machine: read the ratios.\n",
@@ -55,6 +57,15 @@ fn main() {
             let sun = Sun::new(az, el).unwrap();
             let track = Track::new(&sun, map.cell_size);
             let (ts, (mask, stats)) = best(3, || shadow_mask_sweep(&map, Some(&mip), &track));
+            if !with_a2 {
+                println!(
+                    "| {n}² | {el}° | {:.2} ms | {:.1} ms | {:.1}x |",
+                    floor * 1e3,
+                    ts * 1e3,
+                    ts / floor
+                );
+                continue;
+            }
             let (ta, a2) = best(1, || {
                 shadow_mask(
                     &map,

@@ -47,7 +47,7 @@ use super::accelerated_traversal::shadowed_accelerated;
 use super::exact_traversal::shadowed_exact;
 use super::minmax_mipmap::MinMaxMipmap;
 use super::sun::{Track, TrackKind};
-use super::sweep_bound::{directional_bound, height_range, transpose};
+use super::sweep_bound::{bound_row, height_range, transpose, BoundSun};
 use super::sweep_exact::{witness, Walk};
 use super::sweep_near::{decide, Axes, NearStencil};
 use crate::heightmap::HeightMap;
@@ -126,9 +126,9 @@ struct Frame<'a> {
     /// Canonical width and height.
     w: usize,
     h: usize,
-    /// Canonical heights and the bound D, row-major in the canonical frame.
+    /// Canonical heights, row-major in the canonical frame, and the sun for their bound D.
     z: Cow<'a, [f32]>,
-    d: Vec<f32>,
+    bound: BoundSun,
     /// u in canonical axes; m = ucx / ucy.
     ucx: f64,
     ucy: f64,
@@ -156,7 +156,7 @@ impl<'a> Frame<'a> {
         let (lo, hi) = height_range(&map.heights);
         let peak = lo.abs().max(hi.abs());
         let (rx, ry) = (track.rise_per_t * ucx, track.rise_per_t * ucy);
-        let d = directional_bound(&z, w, h, rx, ry, peak);
+        let bound = BoundSun::new(rx, ry, peak);
         let rise = track.rise_per_t;
         let span = (map.width + map.height) as f64 + 2.0;
         let eps = 1e-9 * ((lo as f64).abs().max((hi as f64).abs()) + rise * span) + 1e-12;
@@ -184,7 +184,7 @@ impl<'a> Frame<'a> {
             w,
             h,
             z,
-            d,
+            bound,
             ucx,
             ucy,
             m: ucx / ucy,
@@ -249,6 +249,7 @@ impl<'a> Frame<'a> {
         let mut gp = vec![f64::NEG_INFINITY; nq + 8];
         let mut wmax = vec![f64::NEG_INFINITY; nq];
         let mut near = vec![0.0f32; nq + 2];
+        let mut drow = vec![0.0f32; nq + 8];
         let mut stats = SweepStats::default();
         let up = self.ucy > 0.0;
         let kx = self.rise * self.ucx;
@@ -268,7 +269,6 @@ impl<'a> Frame<'a> {
                 gp.resize(len, f64::NEG_INFINITY);
             }
             let x_first = q0 + omin;
-            let drow = &self.d[y * self.w..(y + 1) * self.w];
             // Columns x_first + t for t in ta..tb lie on the map.
             let ta = (-x_first).clamp(0, len as i64) as usize;
             let tb = (self.w as i64 - x_first).clamp(ta as i64, len as i64) as usize;
@@ -276,7 +276,12 @@ impl<'a> Frame<'a> {
             gp[tb..len].fill(f64::NEG_INFINITY);
             if ta < tb {
                 let xa = (x_first + ta as i64) as usize;
-                for (t, (g, &dv)) in gp[ta..tb].iter_mut().zip(&drow[xa..]).enumerate() {
+                if drow.len() < tb - ta {
+                    drow.resize(tb - ta, 0.0);
+                }
+                let drow = &mut drow[..tb - ta];
+                bound_row(&self.z, self.w, self.h, y, xa, self.bound, drow);
+                for (t, (g, &dv)) in gp[ta..tb].iter_mut().zip(&*drow).enumerate() {
                     *g = dv as f64 - kx * ((xa + t) as f64 + 0.5);
                 }
             }

@@ -4,61 +4,89 @@
 
 use rayon::prelude::*;
 
-/// D(T): the maximum over T's square of F(q) = h(q) − rise·(q − c_T)·u at the nine points
-/// where it can lie (module docs), border-clamped like [`sample_bilinear`], for a w×h grid
-/// and the sun's rise per texel along x and y (`rise·u_x`, `rise·u_y`); `peak` is at least
-/// every |height| ([`height_range`]). Evaluated in f32 (it vectorises) and then raised by 2e-6
-/// of the largest magnitude, which covers f32 rounding of the nine sums (about 8 ulps) with a
-/// margin of 30.
+/// The sun's half-texel rises and the raise that makes [`bound_row`] an upper bound.
+#[derive(Clone, Copy, Debug)]
+pub struct BoundSun {
+    /// ½·rise·u_x and ½·rise·u_y in the grid's axes.
+    pub ex: f32,
+    pub ey: f32,
+    /// 2e-6 of the largest magnitude summed (module docs of [`bound_row`]).
+    pub raise: f32,
+}
+
+impl BoundSun {
+    /// For the sun's rise per texel along x and y (`rise·u_x`, `rise·u_y`) over heights whose
+    /// magnitude is at most `peak` ([`height_range`]).
+    pub fn new(rise_x: f64, rise_y: f64, peak: f32) -> BoundSun {
+        let (ex, ey) = ((0.5 * rise_x) as f32, (0.5 * rise_y) as f32);
+        BoundSun {
+            ex,
+            ey,
+            raise: 2e-6 * (peak + ex.abs() + ey.abs()),
+        }
+    }
+}
+
+/// D(T) for the texels (xa + i, y), i < out.len(), of a w×h row-major grid: the maximum over
+/// T's square of F(q) = h(q) − rise·(q − c_T)·u at the nine points where it can lie (the
+/// centre, the edge midpoints, the corners: F is bilinear on each quarter of the square),
+/// border-clamped like [`sample_bilinear`]. Evaluated in f32 (it vectorises) and then raised by
+/// 2e-6 of the largest magnitude, which covers f32 rounding of the nine sums (about 8 ulps)
+/// with a margin of 30. Computed row by row where the sweep needs it, so the bound of the whole
+/// map is never stored (a 4096² map's would be 64 MiB of fresh pages per sun).
 ///
 /// [`sample_bilinear`]: super::exact_traversal::sample_bilinear
-pub fn directional_bound(
-    heights: &[f32],
+#[allow(clippy::too_many_arguments)]
+pub fn bound_row(
+    z: &[f32],
     w: usize,
     h: usize,
-    rise_x: f64,
-    rise_y: f64,
-    peak: f32,
-) -> Vec<f32> {
-    let (ex, ey) = ((0.5 * rise_x) as f32, (0.5 * rise_y) as f32);
-    let raise = 2e-6 * (peak + ex.abs() + ey.abs());
-    let mut d = vec![0.0f32; w * h];
+    y: usize,
+    xa: usize,
+    sun: BoundSun,
+    out: &mut [f32],
+) {
+    let n = out.len();
+    debug_assert!(xa + n <= w);
+    let (n_row, s_row) = (y.saturating_sub(1), (y + 1).min(h - 1));
+    let rows = [
+        &z[n_row * w..(n_row + 1) * w],
+        &z[y * w..(y + 1) * w],
+        &z[s_row * w..(s_row + 1) * w],
+    ];
+    let BoundSun { ex, ey, raise } = sun;
     let max = |a: f32, b: f32| if b > a { b } else { a };
-    d.par_chunks_mut(w).enumerate().for_each_init(
-        || {
-            [
-                vec![0.0f32; w + 2],
-                vec![0.0f32; w + 2],
-                vec![0.0f32; w + 2],
-            ]
-        },
-        |[rn, rc, rs], (y, out)| {
-            let (n, s) = (y.saturating_sub(1), (y + 1).min(h - 1));
-            // Rows padded by one clamped texel on each side, so the inner loop has no branches.
-            for (r, v) in [(n, &mut *rn), (y, &mut *rc), (s, &mut *rs)] {
-                let row = &heights[r * w..(r + 1) * w];
-                v[0] = row[0];
-                v[1..=w].copy_from_slice(row);
-                v[w + 1] = row[w - 1];
-            }
-            for (x, o) in out.iter_mut().enumerate() {
-                let (l, c, r) = (rc[x], rc[x + 1], rc[x + 2]);
-                let (nl, nc, nr) = (rn[x], rn[x + 1], rn[x + 2]);
-                let (sl, sc, sr) = (rs[x], rs[x + 1], rs[x + 2]);
-                // Offsets in texels: west (−½, 0), east, north (0, −½), south, and the corners.
-                let mut v = max(c, 0.5 * (c + l) + ex);
-                v = max(v, 0.5 * (c + r) - ex);
-                v = max(v, 0.5 * (c + nc) + ey);
-                v = max(v, 0.5 * (c + sc) - ey);
-                v = max(v, 0.25 * (c + l + nc + nl) + ex + ey);
-                v = max(v, 0.25 * (c + r + nc + nr) - ex + ey);
-                v = max(v, 0.25 * (c + l + sc + sl) + ex - ey);
-                v = max(v, 0.25 * (c + r + sc + sr) - ex - ey);
-                *o = v + raise;
-            }
-        },
-    );
-    d
+    // Offsets in texels: west (−½, 0), east, north (0, −½), south, and the corners.
+    let nine = |[nl, nc, nr]: [f32; 3], [l, c, r]: [f32; 3], [sl, sc, sr]: [f32; 3]| {
+        let mut v = max(c, 0.5 * (c + l) + ex);
+        v = max(v, 0.5 * (c + r) - ex);
+        v = max(v, 0.5 * (c + nc) + ey);
+        v = max(v, 0.5 * (c + sc) - ey);
+        v = max(v, 0.25 * (c + l + nc + nl) + ex + ey);
+        v = max(v, 0.25 * (c + r + nc + nr) - ex + ey);
+        v = max(v, 0.25 * (c + l + sc + sl) + ex - ey);
+        v = max(v, 0.25 * (c + r + sc + sr) - ex - ey);
+        v + raise
+    };
+    // A texel and its clamped neighbours in one row.
+    let three = |row: &[f32], x: usize| [row[x.saturating_sub(1)], row[x], row[(x + 1).min(w - 1)]];
+    let edge = |x: usize| nine(three(rows[0], x), three(rows[1], x), three(rows[2], x));
+    // Interior columns 1..w−1 without clamps (they vectorise), the border ones clamped.
+    let (ia, ib) = (xa.max(1), (xa + n).min(w - 1).max(xa.max(1)));
+    for x in (xa..ia).chain(ib..xa + n) {
+        out[x - xa] = edge(x);
+    }
+    if ia < ib {
+        let m = ib - ia;
+        let [rn, rc, rs] = rows.map(|r| &r[ia - 1..ib + 1]);
+        for (i, o) in out[ia - xa..][..m].iter_mut().enumerate() {
+            *o = nine(
+                [rn[i], rn[i + 1], rn[i + 2]],
+                [rc[i], rc[i + 1], rc[i + 2]],
+                [rs[i], rs[i + 1], rs[i + 2]],
+            );
+        }
+    }
 }
 
 /// The smallest and largest height (one parallel pass; the heights must not be NaN).
@@ -77,18 +105,28 @@ pub fn height_range(heights: &[f32]) -> (f32, f32) {
         )
 }
 
-/// Transpose a w×h row-major grid (blocked for the cache).
+/// Transpose a w×h row-major grid. Tiles of 64×64 go through a buffer in L1: each tile's 64
+/// source rows are read and its 64 destination rows written as whole runs, so no access walks
+/// a column with the map's stride (a 4096-wide map's rows are 16 KiB apart, and a column of
+/// them maps onto one set of the L1 cache: the previous 32×32 blocking thrashed it, 52 ms
+/// against 12 ms for this at 4096², docs/terrain.md).
 pub fn transpose(src: &[f32], w: usize, h: usize) -> Vec<f32> {
-    const B: usize = 32;
+    const T: usize = 64;
     let mut dst = vec![0.0f32; w * h];
     // dst is h wide and w tall: dst[x * h + y] = src[y * w + x].
-    dst.par_chunks_mut(h * B).enumerate().for_each(|(bx, out)| {
-        let x0 = bx * B;
+    dst.par_chunks_mut(h * T).enumerate().for_each(|(bx, out)| {
+        let x0 = bx * T;
         let xs = out.len() / h;
-        for y0 in (0..h).step_by(B) {
-            for x in x0..x0 + xs {
-                for y in y0..(y0 + B).min(h) {
-                    out[(x - x0) * h + y] = src[y * w + x];
+        let mut tile = [[0.0f32; T]; T];
+        for y0 in (0..h).step_by(T) {
+            let ys = T.min(h - y0);
+            for (dy, t) in tile[..ys].iter_mut().enumerate() {
+                t[..xs].copy_from_slice(&src[(y0 + dy) * w + x0..][..xs]);
+            }
+            for dx in 0..xs {
+                let o = &mut out[dx * h + y0..][..ys];
+                for (dy, o) in o.iter_mut().enumerate() {
+                    *o = tile[dy][dx];
                 }
             }
         }
@@ -112,15 +150,20 @@ mod tests {
         let map = HeightMap::new(w, h, heights, [1.0, 1.0]);
         for az in [0.0, 37.0, 90.0, 200.0, 300.0] {
             let track = Track::new(&Sun::new(az, 25.0).unwrap(), [1.0, 2.0]);
-            let d = directional_bound(
-                &map.heights,
-                w,
-                h,
+            let sun = BoundSun::new(
                 track.rise_per_t * track.ux,
                 track.rise_per_t * track.uy,
                 7.5 * 1.5,
             );
             for y in 0..h {
+                // Whole rows and pieces of rows (the sweep asks for windows).
+                let mut d = vec![0.0f32; w];
+                bound_row(&map.heights, w, h, y, 0, sun, &mut d);
+                for (xa, n) in [(0, 1), (1, 3), (4, 3), (6, 1), (2, 5)] {
+                    let mut part = vec![0.0f32; n];
+                    bound_row(&map.heights, w, h, y, xa, sun, &mut part);
+                    assert_eq!(part[..], d[xa..xa + n], "row {y} from {xa}");
+                }
                 for x in 0..w {
                     let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
                     let mut peak = f64::NEG_INFINITY;
@@ -132,7 +175,7 @@ mod tests {
                             peak = peak.max(f);
                         }
                     }
-                    let dv = d[y * w + x] as f64;
+                    let dv = d[x] as f64;
                     // An upper bound, and tight: the peak is at one of the 9 grid points.
                     assert!(
                         peak <= dv && dv - peak < 1e-3,
