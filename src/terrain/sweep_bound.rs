@@ -164,7 +164,7 @@ mod tests {
                     bound_row(&map.heights, w, h, y, xa, sun, &mut part);
                     assert_eq!(part[..], d[xa..xa + n], "row {y} from {xa}");
                 }
-                for x in 0..w {
+                for (x, &dv) in d.iter().enumerate() {
                     let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
                     let mut peak = f64::NEG_INFINITY;
                     for i in 0..=16 {
@@ -175,7 +175,7 @@ mod tests {
                             peak = peak.max(f);
                         }
                     }
-                    let dv = d[x] as f64;
+                    let dv = dv as f64;
                     // An upper bound, and tight: the peak is at one of the 9 grid points.
                     assert!(
                         peak <= dv && dv - peak < 1e-3,
