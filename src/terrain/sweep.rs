@@ -107,15 +107,19 @@ pub fn shadow_mask_sweep(
         TrackKind::Ray => {}
     }
     let frame = Frame::new(map, track);
-    let mut mask: Vec<AtomicU8> = Vec::with_capacity(n);
-    mask.par_extend((0..n).into_par_iter().map(|_| AtomicU8::new(0)));
+    // Zeroed by the allocator: only the pages of shadowed pixels are ever written.
+    let mut mask = vec![0u8; n];
+    // SAFETY: AtomicU8 has the size, alignment and bit validity of u8, and `mask` is not
+    // otherwise touched while the view lives.
+    let view: &[AtomicU8] = unsafe { &*(mask.as_mut_slice() as *mut [u8] as *const [AtomicU8]) };
     let (jmin, jmax) = frame.band_range();
     let starts: Vec<i64> = (jmin..=jmax).step_by(CHUNK as usize).collect();
     let stats = starts
         .par_iter()
-        .map(|&j0| frame.sweep_bands(map, mip, j0, (j0 + CHUNK).min(jmax + 1), &mask))
+        .map(|&j0| frame.sweep_bands(map, mip, j0, (j0 + CHUNK).min(jmax + 1), view))
         .reduce(SweepStats::default, SweepStats::add);
-    let mask = mask.into_par_iter().map(|v| v.into_inner() != 0).collect();
+    // In place: the same allocation becomes the Vec<bool>.
+    let mask = mask.into_iter().map(|v| v != 0).collect();
     (mask, stats)
 }
 
@@ -249,6 +253,7 @@ impl<'a> Frame<'a> {
         let mut gp = vec![f64::NEG_INFINITY; nq + 8];
         let mut wmax = vec![f64::NEG_INFINITY; nq];
         let mut near = vec![0.0f32; nq + 2];
+        let mut lit = vec![0u8; nq + 2];
         let mut drow = vec![0.0f32; nq + 8];
         let mut stats = SweepStats::default();
         let up = self.ucy > 0.0;
@@ -257,7 +262,8 @@ impl<'a> Frame<'a> {
             let y = if up { self.h - 1 - step } else { step };
             // The ring slot of the row `lines − 1` steps back (it joins best2 now).
             let slot = step % slots;
-            self.decide_row(map, mip, y, j0, j1, &bands, &mut near, mask, &mut stats);
+            let scratch = (&mut near[..], &mut lit[..]);
+            self.decide_row(map, mip, y, (j0, j1), &bands, scratch, mask, &mut stats);
             // Rows beyond the next one of the rows still to come: the previous row joins.
             // This row's window values: for band j = K·q + s the maximum of g over
             // q + lo[s] ..= q + hi[s] (−∞ off the map).
@@ -325,10 +331,9 @@ impl<'a> Frame<'a> {
         map: &HeightMap,
         mip: Option<&MinMaxMipmap>,
         y: usize,
-        j0: i64,
-        j1: i64,
+        (j0, j1): (i64, i64),
         bands: &Bands,
-        near: &mut [f32],
+        (near, lit): (&mut [f32], &mut [u8]),
         mask: &[AtomicU8],
         stats: &mut SweepStats,
     ) {
@@ -355,16 +360,36 @@ impl<'a> Frame<'a> {
         let zrow = &self.z[y * self.w..(y + 1) * self.w];
         let margin = self.near.margin;
         let (rise, eps, ucx, ycy) = (self.rise, self.eps, self.ucx, (y as f64 + 0.5) * self.ucy);
-        for x in x0..=x1 {
-            let i = (band_base + x) as usize;
-            // The common case first: no texel of the first lines above the ray, bound below.
-            if xs <= x && x <= xe && near[(x - xs) as usize] < -margin {
-                let pu = (x as f64 + 0.5) * ucx + ycy;
-                if bands.best2[i] + rise * pu <= zrow[x as usize] as f64 - eps {
+        // The common case for a whole run of pixels at once (it vectorises): no texel of the
+        // first lines above the ray, and the bound below.
+        if xs <= xe {
+            let n = (xe - xs + 1) as usize;
+            let best = &bands.best2[(band_base + xs) as usize..][..n];
+            let z = &zrow[xs as usize..][..n];
+            let pixels = lit[..n].iter_mut().zip(&near[..n]).zip(best.iter().zip(z));
+            for (k, ((l, &v), (&b, &zp))) in pixels.enumerate() {
+                // i32 → f64 converts in one vector instruction; the map is under 2³¹ wide.
+                let pu = ((xs as i32 + k as i32) as f64 + 0.5) * ucx + ycy;
+                *l = ((v < -margin) & (b + rise * pu <= zp as f64 - eps)) as u8;
+            }
+        }
+        const ALL_LIT: u64 = 0x0101_0101_0101_0101;
+        let mut x = x0;
+        while x <= x1 {
+            if xs <= x && x <= xe {
+                let k = (x - xs) as usize;
+                if x + 7 <= xe && u64::from_le_bytes(lit[k..k + 8].try_into().unwrap()) == ALL_LIT {
+                    stats.lit_by_bound += 8;
+                    x += 8;
+                    continue;
+                }
+                if lit[k] != 0 {
                     stats.lit_by_bound += 1;
+                    x += 1;
                     continue;
                 }
             }
+            let i = (band_base + x) as usize;
             let (col, row) = if self.transposed {
                 (y, x as usize)
             } else {
@@ -396,6 +421,7 @@ impl<'a> Frame<'a> {
             if shadowed {
                 mask[row * map.width + col].store(1, Ordering::Relaxed);
             }
+            x += 1;
         }
     }
 
