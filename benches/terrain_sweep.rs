@@ -56,7 +56,7 @@ fn main() {
         for &el in &elevations {
             let sun = Sun::new(az, el).unwrap();
             let track = Track::new(&sun, map.cell_size);
-            let (ts, (mask, stats)) = best(3, || shadow_mask_sweep(&map, Some(&mip), &track));
+            let (ts, (mask, stats)) = best(3, || shadow_mask_sweep(&map, &track));
             if !with_a2 {
                 println!(
                     "| {n}² | {el}° | {:.2} ms | {:.1} ms | {:.1}x |",

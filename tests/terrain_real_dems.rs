@@ -37,7 +37,7 @@ fn check_all_suns(map: &HeightMap, name: &str) {
         let az = k as f64 * 22.5;
         for el in [5.0, 15.0, 30.0, 60.0] {
             let track = Track::new(&Sun::new(az, el).unwrap(), map.cell_size);
-            let (swept, _) = shadow_mask_sweep(map, Some(&mip), &track);
+            let (swept, _) = shadow_mask_sweep(map, &track);
             let (differ, shadowed): (usize, usize) = (0..map.height)
                 .into_par_iter()
                 .map(|r| {
@@ -98,7 +98,7 @@ fn puget_sound_4k_sweep_equals_the_accelerated_traversal() {
     assert_eq!((map.width, map.height), (4096, 4096));
     let mip = MinMaxMipmap::build(&map);
     let track = Track::new(&Sun::new(300.0, 5.0).unwrap(), map.cell_size);
-    let (swept, stats) = shadow_mask_sweep(&map, Some(&mip), &track);
+    let (swept, stats) = shadow_mask_sweep(&map, &track);
     let differ: usize = (0..map.height)
         .into_par_iter()
         .map(|r| {

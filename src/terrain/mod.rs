@@ -36,6 +36,7 @@ pub mod solar;
 pub mod sun;
 pub mod sunlight;
 pub mod sweep;
+pub mod sweep_bands;
 pub mod sweep_bound;
 pub mod sweep_exact;
 pub mod sweep_near;

@@ -21,7 +21,7 @@ pub enum HardMethod {
     Exact,
     /// Over the min/max mipmap (algorithm A2).
     Accelerated,
-    /// A certified sweep along the sun's azimuth; undecided pixels by A2.
+    /// A certified sweep along the sun's azimuth; undecided pixels line by line (no mipmap).
     #[default]
     Sweep,
 }
@@ -37,7 +37,7 @@ impl HardMethod {
 }
 
 /// Shadow mask of `map` (row-major, `true` = in shadow). `mip` is used by `Accelerated` (built
-/// on the fly when `None`). Deterministic for any thread count.
+/// on the fly when `None`); the others ignore it. Deterministic for any thread count.
 pub fn shadow_mask(
     map: &HeightMap,
     sun: &Sun,
@@ -46,20 +46,20 @@ pub fn shadow_mask(
     progress: &dyn Progress,
 ) -> Vec<bool> {
     let track = Track::new(sun, map.cell_size);
+    if method == HardMethod::Sweep {
+        progress.begin("shadow", 0);
+        let (mask, _) = shadow_mask_sweep(map, &track);
+        progress.finish();
+        return mask;
+    }
     let built;
     let mip = match (method, mip) {
-        (HardMethod::Accelerated | HardMethod::Sweep, None) => {
+        (HardMethod::Accelerated, None) => {
             built = MinMaxMipmap::build(map);
             Some(&built)
         }
         (_, m) => m,
     };
-    if method == HardMethod::Sweep {
-        progress.begin("shadow", 0);
-        let (mask, _) = shadow_mask_sweep(map, mip, &track);
-        progress.finish();
-        return mask;
-    }
     let (_, max_height) = map.min_max();
     progress.begin("shadow", map.height as u64);
     let rows: Vec<Vec<bool>> = (0..map.height)

@@ -43,10 +43,10 @@
 //! beyond its error bound), every "lit" a bound with margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D is rounded up to f32).
 //! The answer of every pixel is exact, so it does not depend on the order or the threads.
 
-use super::accelerated_traversal::shadowed_accelerated;
+#[cfg(doc)]
 use super::exact_traversal::shadowed_exact;
-use super::minmax_mipmap::MinMaxMipmap;
 use super::sun::{Track, TrackKind};
+use super::sweep_bands::{Bands, BLOCK};
 use super::sweep_bound::{bound_row, height_range, transpose, BoundSun};
 use super::sweep_exact::{witness, Walk};
 use super::sweep_near::{decide, Axes, NearStencil};
@@ -94,12 +94,8 @@ const LINES_LOW: i64 = 8;
 const LOW_SUN: f64 = 0.364;
 
 /// The shadow mask (row-major, `true` = shadowed), equal to the exact traversal's on every
-/// pixel. `mip` speeds up the traversal of undecided pixels (the plain exact traversal without).
-pub fn shadow_mask_sweep(
-    map: &HeightMap,
-    mip: Option<&MinMaxMipmap>,
-    track: &Track,
-) -> (Vec<bool>, SweepStats) {
+/// pixel. Needs no mipmap: undecided pixels are settled line by line from the bands' history.
+pub fn shadow_mask_sweep(map: &HeightMap, track: &Track) -> (Vec<bool>, SweepStats) {
     let n = map.width * map.height;
     match track.kind {
         TrackKind::Zenith => return (vec![false; n], SweepStats::default()),
@@ -116,7 +112,7 @@ pub fn shadow_mask_sweep(
     let starts: Vec<i64> = (jmin..=jmax).step_by(CHUNK as usize).collect();
     let stats = starts
         .par_iter()
-        .map(|&j0| frame.sweep_bands(map, mip, j0, (j0 + CHUNK).min(jmax + 1), view))
+        .map(|&j0| frame.sweep_bands(map, j0, (j0 + CHUNK).min(jmax + 1), view))
         .reduce(SweepStats::default, SweepStats::add);
     // In place: the same allocation becomes the Vec<bool>.
     let mask = mask.into_iter().map(|v| v != 0).collect();
@@ -139,10 +135,10 @@ struct Frame<'a> {
     m: f64,
     rise: f64,
     eps: f64,
-    /// The map's largest height (the plain traversal's early stop).
-    max_height: f32,
-    /// The exact test of the texels of the first `lines` lines, for whole rows.
+    /// The exact test of the texels of the first `lines` lines, for whole rows; and of the
+    /// texels of any one line, for one pixel.
     near: NearStencil,
+    far_lines: NearStencil,
     lines: i64,
 }
 
@@ -182,6 +178,7 @@ impl<'a> Frame<'a> {
             LINES
         };
         let near = NearStencil::new(axes, rise, lines, hi as f64 - lo as f64);
+        let far_lines = NearStencil::new(axes, rise, h as i64, hi as f64 - lo as f64);
         Frame {
             track,
             transposed,
@@ -194,8 +191,8 @@ impl<'a> Frame<'a> {
             m: ucx / ucy,
             rise,
             eps,
-            max_height: hi,
             near,
+            far_lines,
             lines,
         }
     }
@@ -230,25 +227,11 @@ impl<'a> Frame<'a> {
     }
 
     /// Sweep bands [j0, j1) over every row from the sun's side, deciding their pixels.
-    fn sweep_bands(
-        &self,
-        map: &HeightMap,
-        mip: Option<&MinMaxMipmap>,
-        j0: i64,
-        j1: i64,
-        mask: &[AtomicU8],
-    ) -> SweepStats {
+    fn sweep_bands(&self, map: &HeightMap, j0: i64, j1: i64, mask: &[AtomicU8]) -> SweepStats {
         let q0 = j0.div_euclid(K);
-        let slots = (self.lines - 1) as usize;
         let nq = (j1 - j0 + K - 1) as usize / K as usize;
-        let mut bands = Bands {
-            q0,
-            nq,
-            best2: vec![f64::NEG_INFINITY; K as usize * nq],
-            row2: vec![u32::MAX; K as usize * nq],
-            prev: vec![f64::NEG_INFINITY; slots * K as usize * nq],
-        };
-        let mut prev_row = vec![u32::MAX; slots];
+        let slots = (self.lines - 1) as usize;
+        let mut bands = Bands::new(q0, nq, K as usize, slots, self.h);
         // Scratch: the row's g = D − rise·x·u_x (padded), one window's maxima, the stencil.
         let mut gp = vec![f64::NEG_INFINITY; nq + 8];
         let mut wmax = vec![f64::NEG_INFINITY; nq];
@@ -256,18 +239,12 @@ impl<'a> Frame<'a> {
         let mut lit = vec![0u8; nq + 2];
         let mut drow = vec![0.0f32; nq + 8];
         let mut stats = SweepStats::default();
-        let up = self.ucy > 0.0;
-        let kx = self.rise * self.ucx;
         for step in 0..self.h {
-            let y = if up { self.h - 1 - step } else { step };
-            // The ring slot of the row `lines − 1` steps back (it joins best2 now).
-            let slot = step % slots;
+            let y = self.line(step);
             let scratch = (&mut near[..], &mut lit[..]);
-            self.decide_row(map, mip, y, (j0, j1), &bands, scratch, mask, &mut stats);
-            // Rows beyond the next one of the rows still to come: the previous row joins.
+            self.decide_row(map, (y, step), (j0, j1), &bands, scratch, mask, &mut stats);
             // This row's window values: for band j = K·q + s the maximum of g over
             // q + lo[s] ..= q + hi[s] (−∞ off the map).
-            let row_term = self.rise * (y as f64 + 0.5) * self.ucy;
             let (lo, hi) = self.window(y);
             let omin = lo[0];
             let len = nq + (hi[K as usize - 1] - omin) as usize;
@@ -286,14 +263,12 @@ impl<'a> Frame<'a> {
                     drow.resize(tb - ta, 0.0);
                 }
                 let drow = &mut drow[..tb - ta];
-                bound_row(&self.z, self.w, self.h, y, xa, self.bound, drow);
-                for (t, (g, &dv)) in gp[ta..tb].iter_mut().zip(&*drow).enumerate() {
-                    *g = dv as f64 - kx * ((xa + t) as f64 + 0.5);
-                }
+                self.g_row(y, xa, drow, &mut gp[ta..tb]);
             }
             // Only bands ra..rb have a window on the map in this row.
             let ra = (-hi[K as usize - 1] - q0).clamp(0, nq as i64) as usize;
             let rb = (self.w as i64 - lo[0] - q0).clamp(ra as i64, nq as i64) as usize;
+            let row_term = self.row_term(y);
             for s in 0..K as usize {
                 wmax.fill(f64::NEG_INFINITY);
                 for o in lo[s]..=hi[s] {
@@ -302,26 +277,36 @@ impl<'a> Frame<'a> {
                         *m = if g > *m { g } else { *m };
                     }
                 }
-                let r = s * nq..(s + 1) * nq;
-                let pr = (slot * K as usize + s) * nq..(slot * K as usize + s + 1) * nq;
-                let (best2, row2, prev) = (
-                    &mut bands.best2[r.clone()],
-                    &mut bands.row2[r],
-                    &mut bands.prev[pr],
-                );
-                let prev_row = prev_row[slot];
-                for i in 0..nq {
-                    let p = prev[i];
-                    if p > best2[i] {
-                        best2[i] = p;
-                        row2[i] = prev_row;
-                    }
-                    prev[i] = wmax[i] - row_term;
-                }
+                bands.push(step, s, &wmax, row_term);
             }
-            prev_row[slot] = y as u32;
+            bands.end_step(step, y);
         }
         stats
+    }
+
+    /// The canonical line visited at `step` (rows from the sun's side).
+    fn line(&self, step: usize) -> usize {
+        if self.ucy > 0.0 {
+            self.h - 1 - step
+        } else {
+            step
+        }
+    }
+
+    /// rise·(y + ½)·u_y, the line's share of rise·c·u.
+    fn row_term(&self, y: usize) -> f64 {
+        self.rise * (y as f64 + 0.5) * self.ucy
+    }
+
+    /// g = D − rise·(x + ½)·u_x for the texels (xa + t, y), t < g.len(), using `d` (as long)
+    /// as scratch for the bound.
+    fn g_row(&self, y: usize, xa: usize, d: &mut [f32], g: &mut [f64]) {
+        bound_row(&self.z, self.w, self.h, y, xa, self.bound, d);
+        let kx = self.rise * self.ucx;
+        for (t, (g, &dv)) in g.iter_mut().zip(&*d).enumerate() {
+            // i32 → f64 converts in one vector instruction; the map is under 2³¹ wide.
+            *g = dv as f64 - kx * ((xa as i32 + t as i32) as f64 + 0.5);
+        }
     }
 
     /// Decide the pixels of canonical row y whose band is in [j0, j1).
@@ -329,8 +314,7 @@ impl<'a> Frame<'a> {
     fn decide_row(
         &self,
         map: &HeightMap,
-        mip: Option<&MinMaxMipmap>,
-        y: usize,
+        (y, step): (usize, usize),
         (j0, j1): (i64, i64),
         bands: &Bands,
         (near, lit): (&mut [f32], &mut [u8]),
@@ -389,11 +373,19 @@ impl<'a> Frame<'a> {
                     continue;
                 }
             }
-            let i = (band_base + x) as usize;
             let (col, row) = if self.transposed {
                 (y, x as usize)
             } else {
                 (x as usize, y)
+            };
+            let pixel = Pixel {
+                x,
+                y,
+                step,
+                col,
+                row,
+                z: zrow[x as usize],
+                i: (band_base + x) as usize,
             };
             let stencil = if xs <= x && x <= xe {
                 decide(near[(x - xs) as usize], margin)
@@ -405,16 +397,14 @@ impl<'a> Frame<'a> {
                     stats.shadowed_near += 1;
                     true
                 }
-                Some(false) => {
-                    self.far(map, mip, zrow[x as usize], x, y, col, row, bands, i, stats)
-                }
+                Some(false) => self.far(map, pixel, bands, stats),
                 None => {
                     let mut walk = Walk::new(map, self.track, col, row, self.transposed);
                     if (0..self.lines).any(|_| walk.through_line()) {
                         stats.shadowed_near += 1;
                         true
                     } else {
-                        self.far(map, mip, zrow[x as usize], x, y, col, row, bands, i, stats)
+                        self.far(map, pixel, bands, stats)
                     }
                 }
             };
@@ -425,51 +415,66 @@ impl<'a> Frame<'a> {
         }
     }
 
-    /// Decide a pixel whose own and next lines hold no texel above the ray: the bound over
-    /// the lines beyond, a witness in the line of the band's maximum, else the traversal.
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn far(
-        &self,
-        map: &HeightMap,
-        mip: Option<&MinMaxMipmap>,
-        zp: f32,
-        x: i64,
-        y: usize,
-        col: usize,
-        row: usize,
-        bands: &Bands,
-        i: usize,
-        stats: &mut SweepStats,
-    ) -> bool {
-        let pu = (x as f64 + 0.5) * self.ucx + (y as f64 + 0.5) * self.ucy;
-        if bands.best2[i] + self.rise * pu <= zp as f64 - self.eps {
+    /// Decide a pixel whose first `lines` lines hold no texel above the ray: the bound over
+    /// the lines beyond, a witness in the line of the band's maximum, else line by line
+    /// ([`super::sweep_bands`]): blocks of lines whose maximum clears the bound are lit; in the
+    /// others each line's window value is recomputed, and the lines it does not clear are
+    /// tested exactly.
+    fn far(&self, map: &HeightMap, p: Pixel, bands: &Bands, stats: &mut SweepStats) -> bool {
+        let pu = (p.x as f64 + 0.5) * self.ucx + (p.y as f64 + 0.5) * self.ucy;
+        let (rise, bar) = (self.rise, p.z as f64 - self.eps);
+        // The bound's test, NaN-free values: `clears(v)` proves v's lines lit.
+        let clears = |v: f64| v + rise * pu <= bar;
+        if clears(bands.best2[p.i]) {
             stats.lit_by_bound += 1;
             return false;
         }
-        let line = bands.row2[i];
-        if line != u32::MAX && witness(map, self.track, col, row, line as i64, self.transposed) {
+        // The exact test of the track's texels in line y (a line ahead of the near ones): the
+        // line's stencil where its taps lie on the map and it decides, else the witness.
+        let shadows = |y: usize| {
+            let k = y.abs_diff(p.y);
+            let v = self
+                .far_lines
+                .line_max(&self.z, (self.w, self.h), (p.x, p.y as i64), k);
+            match v.and_then(|v| decide(v, self.far_lines.margin)) {
+                Some(shadowed) => shadowed,
+                None => witness(map, self.track, p.col, p.row, y as i64, self.transposed),
+            }
+        };
+        let line = bands.row2[p.i];
+        if line != u32::MAX && shadows(line as usize) {
             stats.shadowed_by_witness += 1;
             return true;
         }
         stats.traversed += 1;
-        let shadowed = match mip {
-            Some(mip) => shadowed_accelerated(map, mip, self.track, col, row),
-            None => shadowed_exact(map, self.track, col, row, self.max_height),
+        // The steps whose lines joined the bound: 0 ..= p.step − lines.
+        let Some(last) = p.step.checked_sub(self.lines as usize) else {
+            return false;
         };
+        let finished = (last + 1) / BLOCK;
+        let blocks = bands.blocks(p.i, finished);
+        let shadowed = blocks
+            .iter()
+            .enumerate()
+            .filter(|&(_, &v)| !clears(v as f64))
+            .any(|(b, _)| (b * BLOCK..(b + 1) * BLOCK).any(|st| shadows(self.line(st))))
+            || (finished * BLOCK..=last).any(|st| shadows(self.line(st)));
         stats.traversed_shadowed += shadowed as u64;
         shadowed
     }
 }
 
-/// The bands of one work item, entry s·nq + (q − q0) for band j = K·q + s: the maximum over
-/// the lines beyond the next one (best2), the line where it lies, the last line's values.
-struct Bands {
-    q0: i64,
-    nq: usize,
-    best2: Vec<f64>,
-    row2: Vec<u32>,
-    prev: Vec<f64>,
+/// A pixel of the canonical frame handed to [`Frame::far`]: its column x in line y (visited at
+/// `step`), its place in the map, its height and its band's entry i.
+#[derive(Clone, Copy)]
+struct Pixel {
+    x: i64,
+    y: usize,
+    step: usize,
+    col: usize,
+    row: usize,
+    z: f32,
+    i: usize,
 }
 
 #[cfg(test)]
@@ -487,10 +492,12 @@ mod tests {
         let map = HeightMap::new(w, h, heights, [1.0, 1.0]);
         for az in [270.0, 250.0, 290.0, 90.0, 0.0, 180.0] {
             let track = Track::new(&Sun::new(az, 30.0).unwrap(), [1.0, 1.0]);
-            let (mask, _) = shadow_mask_sweep(&map, None, &track);
+            let (mask, _) = shadow_mask_sweep(&map, &track);
             for row in 0..h {
                 for col in 0..w {
-                    let exact = shadowed_exact(&map, &track, col, row, 10.0);
+                    let exact = crate::terrain::exact_traversal::shadowed_exact(
+                        &map, &track, col, row, 10.0,
+                    );
                     assert_eq!(mask[row * w + col], exact, "az {az} ({col}, {row})");
                 }
             }

@@ -54,6 +54,8 @@ pub struct NearStencil {
     pub y_hi: i64,
     /// Decision margin (module docs).
     pub margin: f32,
+    /// Line k's texels are `texels[line_start[k]..line_start[k + 1]]`.
+    pub line_start: Vec<usize>,
 }
 
 /// The canonical frame's axes: (u, step, 1/u) for x (minor) and y (major).
@@ -75,6 +77,7 @@ impl NearStencil {
         let mut tx = Track::exit_time(p, cx, sx, ix);
         let mut ty = Track::exit_time(p, cy, sy, iy);
         let mut texels = Vec::new();
+        let mut line_start = vec![0];
         // The traversal's stepping (exact_traversal::shadowed_exact), from texel (0, 0).
         while cy * sy < lines {
             let t_out = tx.min(ty);
@@ -103,6 +106,7 @@ impl NearStencil {
             if step_y {
                 cy += sy;
                 ty = Track::exit_time(p, cy, sy, iy);
+                line_start.push(texels.len());
             }
             t_in = t_out;
         }
@@ -114,6 +118,7 @@ impl NearStencil {
             y_hi: texels.iter().map(|t| t.oy + 1).max().unwrap_or(0),
             texels,
             margin: (1e-6 * (delta + r_max) + 1e-30) as f32,
+            line_start,
         }
     }
 
@@ -146,6 +151,36 @@ impl NearStencil {
                 out[i] = if v > out[i] { v } else { out[i] };
             }
         }
+    }
+}
+
+impl NearStencil {
+    /// v = max v_k over the texels of line k alone (0 = the pixel's own) for the pixel (x, y)
+    /// of the w×h row-major grid z, as [`NearStencil::row_max`] evaluates it (so [`decide`]
+    /// applies with the same margin), or `None` when a tap of that line leaves the grid (the
+    /// traversal's border clamping would then matter) or the stencil is shorter.
+    pub fn line_max(
+        &self,
+        z: &[f32],
+        (w, h): (usize, usize),
+        (x, y): (i64, i64),
+        k: usize,
+    ) -> Option<f32> {
+        let texels = &self.texels[*self.line_start.get(k)?..*self.line_start.get(k + 1)?];
+        let zp = z[y as usize * w + x as usize];
+        let mut out = f32::NEG_INFINITY;
+        for t in texels {
+            let (tx, ty) = (x + t.ox, y + t.oy);
+            if tx < 0 || ty < 0 || tx + 1 >= w as i64 || ty + 1 >= h as i64 {
+                return None;
+            }
+            let r0 = ty as usize * w + tx as usize;
+            let (a, b, c, d) = (z[r0], z[r0 + 1], z[r0 + w], z[r0 + w + 1]);
+            let [ca, cb, cc, cd] = t.c;
+            let v = ca * (a - zp) + cb * (b - zp) + cc * (c - zp) + cd * (d - zp) - t.rise;
+            out = if v > out { v } else { out };
+        }
+        Some(out)
     }
 }
 

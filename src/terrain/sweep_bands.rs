@@ -1,0 +1,170 @@
+//! The band state of the certified sweep ([`super::sweep`]) for one work item: per band, the
+//! running maximum of its window values over the lines at least L ahead of the current one
+//! (fed through a ring that delays each line's values by L − 1 steps), the line where that
+//! maximum lies, and a history of the maxima of each block of [`BLOCK`] consecutive lines.
+//!
+//! **Why the history.** A pixel whose band maximum does not clear the bound, and whose
+//! witness in the maximum's line is lit, used to be handed to the accelerated traversal
+//! (about 1.4 µs each at 4096², sun 5°: a ray that grazes a distant ridge descends the mipmap
+//! there). With the history its lines are settled where they are: a block whose maximum
+//! clears the bound holds no texel above the ray; in the other blocks each line's window value
+//! is recomputed ([`super::sweep`]) and only the lines it does not clear are tested exactly.
+//! Every line beyond the first L is then either bounded or tested, so the answer stays exact.
+//!
+//! Entry s·nq + (q − q0) is band j = K·q + s. Values are f64 and compared as computed; the
+//! history keeps them as f32 rounded up (never below the f64 value), which halves its size
+//! (1 MiB for 1024 bands of a 4096-line map) and can only send more blocks to the line tests.
+
+/// Lines per history block.
+pub const BLOCK: usize = 16;
+
+/// The bands of one work item ([`super::sweep`]).
+pub struct Bands {
+    pub q0: i64,
+    pub nq: usize,
+    /// Per band: the maximum over the lines at least L ahead, and the line where it lies.
+    pub best2: Vec<f64>,
+    pub row2: Vec<u32>,
+    /// The ring of the last L − 1 lines' values (slot-major), and each slot's line.
+    prev: Vec<f64>,
+    prev_row: Vec<u32>,
+    /// Per band, the maxima of the finished blocks (band-major, `blocks` per band) and of the
+    /// block being filled.
+    hist: Vec<f32>,
+    blocks: usize,
+    cur: Vec<f64>,
+    steps: usize,
+}
+
+impl Bands {
+    /// `nb` bands (K·nq) from q0, a ring of `slots` = L − 1 lines, a map of `steps` lines.
+    pub fn new(q0: i64, nq: usize, k: usize, slots: usize, steps: usize) -> Bands {
+        let n = k * nq;
+        let blocks = steps.div_ceil(BLOCK);
+        Bands {
+            q0,
+            nq,
+            best2: vec![f64::NEG_INFINITY; n],
+            row2: vec![u32::MAX; n],
+            prev: vec![f64::NEG_INFINITY; slots * n],
+            prev_row: vec![u32::MAX; slots],
+            hist: vec![f32::NEG_INFINITY; n * blocks],
+            blocks,
+            cur: vec![f64::NEG_INFINITY; n],
+            steps,
+        }
+    }
+
+    /// Step `step` (canonical line `y`): for sub-band s, `wmax[q − q0]` is the window maximum
+    /// of g = D − rise·x·u_x in this line and `row_term` its rise·y·u_y. The ring's oldest
+    /// line joins `best2`, this line's values take its slot and its block's maximum.
+    pub fn push(&mut self, step: usize, s: usize, wmax: &[f64], row_term: f64) {
+        let (nq, slots) = (self.nq, self.prev_row.len());
+        let slot = step % slots;
+        let n = self.best2.len();
+        let r = s * nq..(s + 1) * nq;
+        let pr = slot * n + s * nq..slot * n + (s + 1) * nq;
+        let (best2, row2) = (&mut self.best2[r.clone()], &mut self.row2[r.clone()]);
+        let (prev, cur) = (&mut self.prev[pr], &mut self.cur[r]);
+        let prev_row = self.prev_row[slot];
+        for i in 0..nq {
+            let p = prev[i];
+            if p > best2[i] {
+                best2[i] = p;
+                row2[i] = prev_row;
+            }
+            let v = wmax[i] - row_term;
+            prev[i] = v;
+            cur[i] = if v > cur[i] { v } else { cur[i] };
+        }
+    }
+
+    /// After every sub-band of step `step` (line `y`) was pushed.
+    pub fn end_step(&mut self, step: usize, y: usize) {
+        let slots = self.prev_row.len();
+        self.prev_row[step % slots] = y as u32;
+        if (step + 1) % BLOCK == 0 || step + 1 == self.steps {
+            let b = step / BLOCK;
+            for (i, c) in self.cur.iter_mut().enumerate() {
+                self.hist[i * self.blocks + b] = round_up(*c);
+                *c = f64::NEG_INFINITY;
+            }
+        }
+    }
+
+    /// The maxima of band entry i's first `n` blocks (each finished).
+    pub fn blocks(&self, i: usize, n: usize) -> &[f32] {
+        &self.hist[i * self.blocks..][..n]
+    }
+}
+
+/// The smallest f32 at least v (v not NaN).
+fn round_up(v: f64) -> f32 {
+    let f = v as f32;
+    if (f as f64) < v {
+        next_up(f)
+    } else {
+        f
+    }
+}
+
+/// The next f32 above a non-NaN f below +∞ (`f32::next_up` needs Rust 1.86; MSRV is 1.85).
+fn next_up(f: f32) -> f32 {
+    if f == 0.0 {
+        f32::from_bits(1)
+    } else if f > 0.0 {
+        f32::from_bits(f.to_bits() + 1)
+    } else {
+        f32::from_bits(f.to_bits() - 1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounding_up_never_lowers() {
+        for v in [
+            0.0,
+            1.0 / 3.0,
+            -1.0 / 3.0,
+            1e30,
+            -1e-30,
+            4097.123456789,
+            f64::NEG_INFINITY,
+        ] {
+            let f = round_up(v);
+            assert!(f as f64 >= v, "{v} -> {f}");
+            assert!(
+                f == f32::NEG_INFINITY || (f.next_down() as f64) < v,
+                "{v} -> {f}"
+            );
+        }
+    }
+
+    #[test]
+    fn blocks_hold_the_maxima_of_their_lines() {
+        // One band (k = 1, nq = 1), ring of 1, 40 lines: block b's maximum is the largest of
+        // lines b·16 .. b·16 + 15, whatever the ring does.
+        let mut bands = Bands::new(0, 1, 1, 1, 40);
+        let vals: Vec<f64> = (0..40).map(|i| ((i * 37) % 23) as f64 - 0.1).collect();
+        for (step, &v) in vals.iter().enumerate() {
+            bands.push(step, 0, &[v], 0.0);
+            bands.end_step(step, step);
+        }
+        let blocks = bands.blocks(0, 3);
+        for (b, &m) in blocks.iter().enumerate() {
+            let want = vals[b * BLOCK..((b + 1) * BLOCK).min(40)]
+                .iter()
+                .fold(f64::NEG_INFINITY, |a, &v| a.max(v));
+            assert!(
+                m as f64 >= want && (m as f64 - want) < 1e-5,
+                "block {b}: {m} vs {want}"
+            );
+        }
+        // best2 holds every line but the last (the ring delays by one).
+        let want = vals[..39].iter().fold(f64::NEG_INFINITY, |a, &v| a.max(v));
+        assert_eq!(bands.best2[0], want);
+    }
+}
