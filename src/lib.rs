@@ -9,6 +9,7 @@ pub mod atmosphere;
 pub mod bake;
 pub mod baked;
 pub mod compress;
+pub mod cpu;
 pub mod error;
 pub mod freeform;
 pub mod gpu;

@@ -148,7 +148,7 @@ impl WideBvh {
     /// The tree of `bvh`, with exact child boxes: `prim_box(i)` is the box of primitive slot `i`
     /// (`bvh.primitive_indices[i]`'s primitive) as (min, max).
     pub fn from_cwbvh(bvh: &CwBvh, prim_box: impl Fn(usize) -> ([f32; 3], [f32; 3])) -> Self {
-        let avx2 = detect_avx2();
+        let avx2 = crate::cpu::has_avx2_fma();
         if bvh.nodes.is_empty() || bvh.primitive_indices.is_empty() {
             return WideBvh {
                 nodes: Vec::new(),
@@ -422,17 +422,6 @@ fn union(a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])) -> ([f32; 3], [f32; 3
     )
 }
 
-fn detect_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 /// The slab test of the eight children, one lane at a time: bit k of the result is set when the
 /// ray meets child k's box within `[tmin, tmax]`, and `dist[k]` is then its entry distance.
 #[inline(always)]
@@ -561,7 +550,7 @@ mod tests {
             }
             prop_assert_eq!(ma >> boxes.len(), 0, "an empty slot was entered");
             #[cfg(target_arch = "x86_64")]
-            if detect_avx2() {
+            if crate::cpu::has_avx2_fma() {
                 let mut b = [0.0; 8];
                 // SAFETY: AVX2 and FMA detected.
                 let mb = unsafe { node_hits_avx2(&n, &ray, 1e-4, tmax, &mut b) };

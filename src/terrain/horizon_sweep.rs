@@ -153,7 +153,7 @@ pub(super) fn sweep_bundles(
     stencils: &Stencils,
     kappa: f64,
 ) -> Vec<f32> {
-    sweep_bundles_with(map, dir, per, stencils, kappa, detect_avx2())
+    sweep_bundles_with(map, dir, per, stencils, kappa, crate::cpu::has_avx2())
 }
 
 /// [`sweep_bundles`] with the AVX2 kernels on or off (they give the same bits).
@@ -444,17 +444,6 @@ unsafe fn eval_avx2(st: &Stencil, hs: &[f32], base: usize, w: usize, out: &mut [
     }
 }
 
-fn detect_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -502,7 +491,7 @@ mod tests {
             kappa in prop::sample::select(vec![0.0, 1e-6, 0.05]),
         ) {
             // CI machines have AVX2 (x86-64-v3): there the comparison must run.
-            if !detect_avx2() {
+            if !crate::cpu::has_avx2() {
                 prop_assert!(std::env::var_os("CI").is_none(), "no AVX2 on this CI machine");
                 return Ok(());
             }
