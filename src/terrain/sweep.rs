@@ -10,8 +10,8 @@
 //!
 //! where D(T) is the maximum of F over T's square. F is the bilinear surface minus a linear
 //! function, bilinear on each quarter of the square, so D(T) is F's largest value at nine
-//! points — the centre, the edge midpoints and the corners ([`directional_bound`], with the
-//! border clamping of [`sample_bilinear`]). Hence
+//! points — the centre, the edge midpoints and the corners ([`bound_row`], with the border
+//! clamping of [`sample_bilinear`]; computed row by row where the bands need it). Hence
 //! `U(P) = rise·p·u + max_{T ∈ S} (D(T) − rise·c_T·u) ≤ z_P − ε` proves that no texel of S
 //! shadows P, for any set S of texels.
 //!
@@ -37,7 +37,12 @@
 //! lies, each with its exact transit — t_in = max(entry_x, entry_y), t_out = min(exit_x,
 //! exit_y), by the same [`Track::crossing`] expressions as the walk, so bit for bit its values;
 //! a texel passing the exact test is a witness: shadow ([`super::sweep_exact::witness`]).
-//! (4) The accelerated traversal.
+//! (4) Line by line ([`super::sweep_bands`]): each band also keeps the maximum of each block
+//! of 16 lines; a block whose maximum passes the bound test holds no texel above the ray, and
+//! every line of the other blocks gets the exact test of P's texels in it — the per-line
+//! stencil ([`NearStencil::line_max`], same constants and margin argument as the near one),
+//! or the witness walk of that line where a tap leaves the map or the value is within the
+//! margin. So every line beyond the first L is bounded or tested: no traversal, no mipmap.
 //!
 //! Every "shadow" is an exact test the walking traversal also makes (or the stencil's value
 //! beyond its error bound), every "lit" a bound with margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D is rounded up to f32).
