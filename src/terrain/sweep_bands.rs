@@ -13,7 +13,7 @@
 //!
 //! Entry s·nq + (q − q0) is band j = K·q + s. Values are f64 and compared as computed; the
 //! history keeps them as f32 rounded up (never below the f64 value), which halves its size
-//! (1 MiB for 1024 bands of a 4096-line map) and can only send more blocks to the line tests.
+//! (512 KiB for a work item's 512 bands over 4096 lines) and can only send more blocks to the line tests.
 
 /// Lines per history block.
 pub const BLOCK: usize = 16;
