@@ -43,6 +43,17 @@ pub struct NearTexel {
     pub rise: f32,
 }
 
+impl NearTexel {
+    /// v_k = Σ c_i·(h_i − z_P) − rise·t_mid for the taps' heights h and the pixel's z_P, in
+    /// the order the margin argument (module docs) assumes; shared by the row and the per-line
+    /// evaluations so that both are bit for bit the same.
+    #[inline(always)]
+    fn value(&self, [a, b, c, d]: [f32; 4], zp: f32) -> f32 {
+        let [ca, cb, cc, cd] = self.c;
+        ca * (a - zp) + cb * (b - zp) + cc * (c - zp) + cd * (d - zp) - self.rise
+    }
+}
+
 /// The stencil of a track's texels in its first `lines` major-axis lines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NearStencil {
@@ -142,19 +153,13 @@ impl NearStencil {
             let r0 = ((y as i64 + t.oy) as usize) * w + (xs as i64 + t.ox) as usize;
             let (a, b) = (&z[r0..][..n], &z[r0 + 1..][..n]);
             let (c, d) = (&z[r0 + w..][..n], &z[r0 + w + 1..][..n]);
-            let [ca, cb, cc, cd] = t.c;
-            let rise = t.rise;
             for i in 0..n {
-                let zp = zc[i];
-                let v = ca * (a[i] - zp) + cb * (b[i] - zp) + cc * (c[i] - zp) + cd * (d[i] - zp)
-                    - rise;
+                let v = t.value([a[i], b[i], c[i], d[i]], zc[i]);
                 out[i] = if v > out[i] { v } else { out[i] };
             }
         }
     }
-}
 
-impl NearStencil {
     /// v = max v_k over the texels of line k alone (0 = the pixel's own) for the pixel (x, y)
     /// of the w×h row-major grid z, as [`NearStencil::row_max`] evaluates it (so [`decide`]
     /// applies with the same margin), or `None` when a tap of that line leaves the grid (the
@@ -175,9 +180,7 @@ impl NearStencil {
                 return None;
             }
             let r0 = ty as usize * w + tx as usize;
-            let (a, b, c, d) = (z[r0], z[r0 + 1], z[r0 + w], z[r0 + w + 1]);
-            let [ca, cb, cc, cd] = t.c;
-            let v = ca * (a - zp) + cb * (b - zp) + cc * (c - zp) + cd * (d - zp) - t.rise;
+            let v = t.value([z[r0], z[r0 + 1], z[r0 + w], z[r0 + w + 1]], zp);
             out = if v > out { v } else { out };
         }
         Some(out)
