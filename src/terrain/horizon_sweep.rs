@@ -288,7 +288,7 @@ fn bundle(
                         finish(4 * g + l, (st.own.t, lanes.own[4 * g + l]), s);
                     }
                 }
-                store(&slopes, first, &[Mode::Stencil; LANES], out);
+                store(&slopes, first as i64, &[Mode::Stencil; LANES], out);
                 continue;
             }
             lanes.mode = [Mode::Stencil; LANES];
@@ -330,17 +330,18 @@ fn bundle(
             finish(j, own, s.unwrap_or(f64::NEG_INFINITY));
             lanes.hulls.push(j, full);
         }
-        store(&slopes, (r * w + c0) as usize, &lanes.mode, out);
+        // The bundle's first lane may lie left of the map (c0 < 0 in row 0): index in i64.
+        store(&slopes, r * w + c0, &lanes.mode, out);
     }
 }
 
 /// The angles (degrees) of the lanes' horizon tangents into `out` from `first` on (lane j at
-/// `first + j`), for the lanes on the map.
-fn store(slopes: &[f64; LANES], first: usize, mode: &[Mode; LANES], out: &[AtomicU32]) {
+/// `first + j`), for the lanes on the map (`first` may be negative when lane 0 is not).
+fn store(slopes: &[f64; LANES], first: i64, mode: &[Mode; LANES], out: &[AtomicU32]) {
     let degrees = atan_degrees(slopes);
     for (j, (&deg, &m)) in degrees.iter().zip(mode).enumerate() {
         if m != Mode::Off {
-            out[first + j].store((deg as f32).to_bits(), Ordering::Relaxed);
+            out[(first + j as i64) as usize].store((deg as f32).to_bits(), Ordering::Relaxed);
         }
     }
 }
@@ -480,6 +481,33 @@ mod tests {
         let per = period(&track, dir);
         let stencils = Stencils::new(&track, dir, &per);
         sweep_bundles_with(map, (dir, &track), &per, &stencils, kappa, avx2)
+    }
+
+    /// Found by the proptest below: in row 0 of an 8-wide map a bundle's first lanes lie left
+    /// of the map, and its output index went below zero (an overflow panic where overflow is
+    /// checked, as in tests). Both paths, the same bits.
+    #[test]
+    fn bundles_starting_left_of_a_narrow_map() {
+        let m = map(8, 56, 0);
+        let d = directions(64, m.cell_size)[17];
+        let d = if d.a.abs() <= d.b.abs() {
+            d
+        } else {
+            Direction {
+                a: d.b,
+                b: d.a,
+                ..d
+            }
+        };
+        let slow = sweep(&m, &d, 0.0, false);
+        assert!(slow.iter().all(|v| v.is_finite()));
+        if crate::cpu::has_avx2() {
+            let fast = sweep(&m, &d, 0.0, true);
+            assert!(fast
+                .iter()
+                .zip(&slow)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
     }
 
     proptest! {
