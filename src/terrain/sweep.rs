@@ -45,13 +45,13 @@
 //! margin. So every line beyond the first L is bounded or tested: no traversal, no mipmap.
 //!
 //! Every "shadow" is an exact test the walking traversal also makes (or the stencil's value
-//! beyond its error bound), every "lit" a bound with margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D is rounded up to f32).
+//! beyond its error bound), every "lit" a bound with margin ε (1e-9 of the largest magnitude compared, for f64 rounding; D and the band values are rounded up to f32).
 //! The answer of every pixel is exact, so it does not depend on the order or the threads.
 
 #[cfg(doc)]
 use super::exact_traversal::shadowed_exact;
 use super::sun::{Track, TrackKind};
-use super::sweep_bands::{Bands, BLOCK};
+use super::sweep_bands::{up_f32, Bands, BLOCK};
 use super::sweep_bound::{bound_row, height_range, transpose, BoundSun};
 use super::sweep_exact::{witness, Walk};
 use super::sweep_near::{decide, Axes, NearStencil};
@@ -241,8 +241,8 @@ impl<'a> Frame<'a> {
         let slots = (self.lines - 1) as usize;
         let mut bands = Bands::new(q0, nq, K as usize, slots, self.h);
         // Scratch: the row's g = D − rise·x·u_x (padded), one window's maxima, the stencil.
-        let mut gp = vec![f64::NEG_INFINITY; nq + 8];
-        let mut wmax = vec![f64::NEG_INFINITY; nq];
+        let mut gp = vec![f32::NEG_INFINITY; nq + 8];
+        let mut wmax = vec![f32::NEG_INFINITY; nq];
         let mut near = vec![0.0f32; nq + 2];
         let mut lit = vec![0u8; nq + 2];
         let mut drow = vec![0.0f32; nq + 8];
@@ -257,14 +257,14 @@ impl<'a> Frame<'a> {
             let omin = lo[0];
             let len = nq + (hi[K as usize - 1] - omin) as usize;
             if gp.len() < len {
-                gp.resize(len, f64::NEG_INFINITY);
+                gp.resize(len, f32::NEG_INFINITY);
             }
             let x_first = q0 + omin;
             // Columns x_first + t for t in ta..tb lie on the map.
             let ta = (-x_first).clamp(0, len as i64) as usize;
             let tb = (self.w as i64 - x_first).clamp(ta as i64, len as i64) as usize;
-            gp[..ta].fill(f64::NEG_INFINITY);
-            gp[tb..len].fill(f64::NEG_INFINITY);
+            gp[..ta].fill(f32::NEG_INFINITY);
+            gp[tb..len].fill(f32::NEG_INFINITY);
             if ta < tb {
                 let xa = (x_first + ta as i64) as usize;
                 if drow.len() < tb - ta {
@@ -276,16 +276,15 @@ impl<'a> Frame<'a> {
             // Only bands ra..rb have a window on the map in this row.
             let ra = (-hi[K as usize - 1] - q0).clamp(0, nq as i64) as usize;
             let rb = (self.w as i64 - lo[0] - q0).clamp(ra as i64, nq as i64) as usize;
-            let row_term = self.row_term(y);
             for s in 0..K as usize {
-                wmax.fill(f64::NEG_INFINITY);
+                wmax.fill(f32::NEG_INFINITY);
                 for o in lo[s]..=hi[s] {
                     let g = &gp[(o - omin) as usize + ra..][..rb - ra];
                     for (m, &g) in wmax[ra..rb].iter_mut().zip(g) {
                         *m = if g > *m { g } else { *m };
                     }
                 }
-                bands.push(step, s, &wmax, row_term);
+                bands.push(step, s, &wmax);
             }
             bands.end_step(step, y);
         }
@@ -301,19 +300,16 @@ impl<'a> Frame<'a> {
         }
     }
 
-    /// rise·(y + ½)·u_y, the line's share of rise·c·u.
-    fn row_term(&self, y: usize) -> f64 {
-        self.rise * (y as f64 + 0.5) * self.ucy
-    }
-
-    /// g = D − rise·(x + ½)·u_x for the texels (xa + t, y), t < g.len(), using `d` (as long)
-    /// as scratch for the bound.
-    fn g_row(&self, y: usize, xa: usize, d: &mut [f32], g: &mut [f64]) {
+    /// g = D − rise·c·u for the texels (xa + t, y), t < g.len(), computed in f64 and stored as
+    /// an f32 no smaller ([`up_f32`]); `d` (as long) is scratch for the bound.
+    fn g_row(&self, y: usize, xa: usize, d: &mut [f32], g: &mut [f32]) {
         bound_row(&self.z, self.w, self.h, y, xa, self.bound, d);
         let kx = self.rise * self.ucx;
+        // rise·(y + ½)·u_y, the line's share of rise·c·u.
+        let row_term = self.rise * (y as f64 + 0.5) * self.ucy;
         for (t, (g, &dv)) in g.iter_mut().zip(&*d).enumerate() {
             // i32 → f64 converts in one vector instruction; the map is under 2³¹ wide.
-            *g = dv as f64 - kx * ((xa as i32 + t as i32) as f64 + 0.5);
+            *g = up_f32(dv as f64 - kx * ((xa as i32 + t as i32) as f64 + 0.5) - row_term);
         }
     }
 
@@ -360,6 +356,7 @@ impl<'a> Frame<'a> {
             let z = &zrow[xs as usize..][..n];
             let pixels = lit[..n].iter_mut().zip(&near[..n]).zip(best.iter().zip(z));
             for (k, ((l, &v), (&b, &zp))) in pixels.enumerate() {
+                let b = b as f64;
                 // i32 → f64 converts in one vector instruction; the map is under 2³¹ wide.
                 let pu = ((xs as i32 + k as i32) as f64 + 0.5) * ucx + ycy;
                 *l = ((v < -margin) & (b + rise * pu <= zp as f64 - eps)) as u8;
@@ -433,7 +430,7 @@ impl<'a> Frame<'a> {
         let (rise, bar) = (self.rise, p.z as f64 - self.eps);
         // The bound's test, NaN-free values: `clears(v)` proves v's lines lit.
         let clears = |v: f64| v + rise * pu <= bar;
-        if clears(bands.best2[p.i]) {
+        if clears(bands.best2[p.i] as f64) {
             stats.lit_by_bound += 1;
             return false;
         }
