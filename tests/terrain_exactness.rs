@@ -144,6 +144,41 @@ fn tracks_touch_at_most_w_plus_h_texels() {
 }
 
 #[test]
+fn ridges_beyond_a_super_block_are_settled_line_by_line() {
+    // A long valley (48 × 700) closed by a rough ridge at its north end: with the sun low in the
+    // north, rays from the south end graze the ridge more than 256 lines (one super-block of
+    // 16 blocks of 16) away, so the sweep settles them through its super-block maxima
+    // (terrain::sweep_bands::SUPER). Both outcomes must occur and equal A1.
+    let (w, h) = (48, 700);
+    let mut rng = Rng(23);
+    let heights: Vec<f32> = (0..w * h)
+        .map(|i| {
+            let ground = rng.unit() as f32;
+            if i / w < 12 {
+                ground + 60.0 * rng.unit() as f32
+            } else {
+                ground
+            }
+        })
+        .collect();
+    let map = HeightMap::new(w, h, heights, [1.0, 1.0]);
+    let (mut settled, mut shadowed) = (0, 0);
+    for az in [0.0, 4.0, 357.0] {
+        for el in [2.0, 3.0, 5.0] {
+            let sun = Sun::new(az, el).unwrap();
+            assert_equal_everywhere(&map, &sun);
+            let (_, stats) = shadow_mask_sweep(&map, &Track::new(&sun, map.cell_size));
+            settled += stats.traversed;
+            shadowed += stats.traversed_shadowed;
+        }
+    }
+    assert!(
+        shadowed > 0 && settled > shadowed,
+        "{settled} settled, {shadowed} shadowed"
+    );
+}
+
+#[test]
 fn distant_ridges_are_settled_line_by_line() {
     // Low ground ringed by a rough ridge: at a low sun many rays graze the ridge far from
     // their pixel, the band bound cannot clear them and the sweep settles them line by line

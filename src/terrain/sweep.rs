@@ -38,8 +38,10 @@
 //! exit_y), by the same [`Track::crossing`] expressions as the walk, so bit for bit its values;
 //! a texel passing the exact test is a witness: shadow ([`super::sweep_exact::witness`]).
 //! (4) Line by line ([`super::sweep_bands`]): each band also keeps the maximum of each block
-//! of 16 lines; a block whose maximum passes the bound test holds no texel above the ray, and
-//! every line of the other blocks gets the exact test of P's texels in it — the per-line
+//! of 16 lines, and of each super-block of 16 blocks; a block or super-block whose maximum
+//! passes the bound test holds no texel above the ray (the super-blocks are scanned first, so a
+//! pixel 4096 lines long reads about 16 + 16 maxima instead of 256), and every line of the
+//! other blocks gets the exact test of P's texels in it — the per-line
 //! stencil ([`NearStencil::line_max`], same constants and margin argument as the near one),
 //! or the witness walk of that line where a tap leaves the map or the value is within the
 //! margin. So every line beyond the first L is bounded or tested: no traversal, no mipmap.
@@ -51,7 +53,7 @@
 #[cfg(doc)]
 use super::exact_traversal::shadowed_exact;
 use super::sun::{Track, TrackKind};
-use super::sweep_bands::{up_f32, Bands, BLOCK};
+use super::sweep_bands::{up_f32, Bands, BLOCK, SUPER};
 use super::sweep_bound::{bound_row, height_range, transpose, BoundSun};
 use super::sweep_exact::{witness, Walk};
 use super::sweep_near::{decide, Axes, NearStencil};
@@ -458,11 +460,19 @@ impl<'a> Frame<'a> {
         };
         let finished = (last + 1) / BLOCK;
         let blocks = bands.blocks(p.i, finished);
-        let shadowed = blocks
+        let supers = bands.supers(p.i, finished / SUPER);
+        // The blocks of `range` that the bound does not clear, line by line.
+        let in_blocks = |range: std::ops::Range<usize>| {
+            range
+                .filter(|&b| !clears(blocks[b] as f64))
+                .any(|b| (b * BLOCK..(b + 1) * BLOCK).any(|st| shadows(self.line(st))))
+        };
+        let shadowed = supers
             .iter()
             .enumerate()
             .filter(|&(_, &v)| !clears(v as f64))
-            .any(|(b, _)| (b * BLOCK..(b + 1) * BLOCK).any(|st| shadows(self.line(st))))
+            .any(|(s, _)| in_blocks(s * SUPER..(s + 1) * SUPER))
+            || in_blocks(supers.len() * SUPER..finished)
             || (finished * BLOCK..=last).any(|st| shadows(self.line(st)));
         stats.traversed_shadowed += shadowed as u64;
         shadowed
