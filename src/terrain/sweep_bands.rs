@@ -78,15 +78,22 @@ impl Bands {
         let (best2, row2) = (&mut self.best2[r.clone()], &mut self.row2[r.clone()]);
         let (prev, cur) = (&mut self.prev[pr], &mut self.cur[r]);
         let prev_row = self.prev_row[slot];
-        for i in 0..nq {
-            let p = prev[i];
-            if p > best2[i] {
-                best2[i] = p;
-                row2[i] = prev_row;
-            }
-            let v = wmax[i];
-            prev[i] = v;
-            cur[i] = if v > cur[i] { v } else { cur[i] };
+        // Zipped slices of one length and selects instead of branches: with f32 values and u32
+        // rows (the same lane width) this vectorises, four bands per SSE instruction.
+        let lanes = best2
+            .iter_mut()
+            .zip(row2.iter_mut())
+            .zip(prev.iter_mut().zip(cur.iter_mut()))
+            .zip(&wmax[..nq]);
+        for (((b, r), (p, c)), &v) in lanes {
+            let older = *p;
+            // All ones where the ring's oldest value beats the best (a bit mask, so that the
+            // compiler keeps both stores unconditional).
+            let take = 0u32.wrapping_sub((older > *b) as u32);
+            *b = f32::from_bits((b.to_bits() & !take) | (older.to_bits() & take));
+            *r = (*r & !take) | (prev_row & take);
+            *p = v;
+            *c = if v > *c { v } else { *c };
         }
     }
 
