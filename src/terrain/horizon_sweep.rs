@@ -483,14 +483,9 @@ mod tests {
         sweep_bundles_with(map, (dir, &track), &per, &stencils, kappa, avx2)
     }
 
-    /// Found by the proptest below: in row 0 of an 8-wide map a bundle's first lanes lie left
-    /// of the map, and its output index went below zero (an overflow panic where overflow is
-    /// checked, as in tests). Both paths, the same bits.
-    #[test]
-    fn bundles_starting_left_of_a_narrow_map() {
-        let m = map(8, 56, 0);
-        let d = directions(64, m.cell_size)[17];
-        let d = if d.a.abs() <= d.b.abs() {
+    /// The steep form of a direction (the sweeper transposes the others).
+    fn steep(d: Direction) -> Direction {
+        if d.a.abs() <= d.b.abs() {
             d
         } else {
             Direction {
@@ -498,7 +493,17 @@ mod tests {
                 b: d.a,
                 ..d
             }
-        };
+        }
+    }
+
+    /// Found by the proptest below: in row 0 of an 8-wide map a bundle's first lanes lie left
+    /// of the map, and its output index went below zero (an overflow panic where overflow is
+    /// checked, as in tests). Both paths, the same bits.
+    #[test]
+    fn bundles_starting_left_of_a_narrow_map() {
+        let m = map(8, 56, 0);
+        let d = directions(64, m.cell_size)[17];
+        let d = steep(d);
         let slow = sweep(&m, &d, 0.0, false);
         assert!(slow.iter().all(|v| v.is_finite()));
         if crate::cpu::has_avx2() {
@@ -525,9 +530,7 @@ mod tests {
             }
             let m = map(w, h, seed);
             let dirs = directions(64, m.cell_size);
-            let d = dirs[k];
-            // The steep form of the direction (the sweeper transposes the others).
-            let d = if d.a.abs() <= d.b.abs() { d } else { Direction { a: d.b, b: d.a, ..d } };
+            let d = steep(dirs[k]);
             let fast = sweep(&m, &d, kappa, true);
             let slow = sweep(&m, &d, kappa, false);
             let same = fast.iter().zip(&slow).filter(|(a, b)| a.to_bits() == b.to_bits()).count();

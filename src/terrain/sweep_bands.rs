@@ -1,18 +1,19 @@
 //! The band state of the certified sweep ([`super::sweep`]) for one work item: per band, the
 //! running maximum of its window values over the lines at least L ahead of the current one
 //! (fed through a ring that delays each line's values by L − 1 steps), the line where that
-//! maximum lies, and a history of the maxima of each block of [`BLOCK`] consecutive lines.
+//! maximum lies, and a history of the maxima of each block of [`BLOCK`] consecutive lines and
+//! of each super-block of [`SUPER`] blocks.
 //!
 //! **Why the history.** A pixel whose band maximum does not clear the bound, and whose
 //! witness in the maximum's line is lit, used to be handed to the accelerated traversal
 //! (about 1.4 µs each at 4096², sun 5°: a ray that grazes a distant ridge descends the mipmap
-//! there). With the history its lines are settled where they are: a block whose maximum
-//! clears the bound holds no texel above the ray; in the other blocks each line's window value
-//! is recomputed ([`super::sweep`]) and only the lines it does not clear are tested exactly.
+//! there). With the history its lines are settled where they are: a super-block or block whose
+//! maximum clears the bound holds no texel above the ray; every line of the other blocks gets
+//! the exact test ([`super::sweep`]).
 //! Every line beyond the first L is then either bounded or tested, so the answer stays exact.
 //!
 //! Entry s·nq + (q − q0) is band j = K·q + s. Values are computed in f64 and kept as f32 no
-//! smaller ([`up_f32`], at most two f32 ulps above): the bands stay upper bounds, so every
+//! smaller ([`up_f32`], at most four f32 ulps above): the bands stay upper bounds, so every
 //! "lit" they prove still holds, and a value can only send more pixels to the exact tests.
 //! Four lanes per SSE instruction instead of two, and half the memory (the history: 512 KiB
 //! for a work item's 512 bands over 4096 lines).
@@ -37,10 +38,9 @@ pub struct Bands {
     /// block being filled.
     hist: Vec<f32>,
     blocks: usize,
-    /// Per band, the maxima of the super-blocks (band-major, `sups` per band): the running
-    /// maximum of their finished blocks.
+    /// Per band, the maxima of the super-blocks (band-major, [`Bands::sups`] per band): the
+    /// running maximum of their finished blocks.
     sup: Vec<f32>,
-    sups: usize,
     cur: Vec<f32>,
     steps: usize,
 }
@@ -60,7 +60,6 @@ impl Bands {
             hist: vec![f32::NEG_INFINITY; n * blocks],
             blocks,
             sup: vec![f32::NEG_INFINITY; n * blocks.div_ceil(SUPER)],
-            sups: blocks.div_ceil(SUPER),
             cur: vec![f32::NEG_INFINITY; n],
             steps,
         }
@@ -102,10 +101,10 @@ impl Bands {
         let slots = self.prev_row.len();
         self.prev_row[step % slots] = y as u32;
         if (step + 1) % BLOCK == 0 || step + 1 == self.steps {
-            let b = step / BLOCK;
+            let (b, sups) = (step / BLOCK, self.sups());
             for (i, c) in self.cur.iter_mut().enumerate() {
                 self.hist[i * self.blocks + b] = *c;
-                let s = &mut self.sup[i * self.sups + b / SUPER];
+                let s = &mut self.sup[i * sups + b / SUPER];
                 *s = if *c > *s { *c } else { *s };
                 *c = f32::NEG_INFINITY;
             }
@@ -119,7 +118,12 @@ impl Bands {
 
     /// The maxima of band entry i's first `n` super-blocks (each of whose blocks finished).
     pub fn supers(&self, i: usize, n: usize) -> &[f32] {
-        &self.sup[i * self.sups..][..n]
+        &self.sup[i * self.sups()..][..n]
+    }
+
+    /// Super-blocks per band.
+    fn sups(&self) -> usize {
+        self.blocks.div_ceil(SUPER)
     }
 }
 
