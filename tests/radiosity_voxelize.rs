@@ -161,6 +161,49 @@ fn transfer_weights_are_convex_and_orientation_compatible() {
     }
 }
 
+/// `corner_patches` weighs the corners at one position together, sharing their nearest-piece
+/// searches: its lists must be those of weighting every corner on its own, bit for bit. The
+/// door-ajar scene has vertices shared by many triangles, voxels holding several patches of one
+/// orientation (the wall and door leaf) and occluded pairs.
+#[test]
+fn corner_lists_equal_weighting_each_corner_alone() {
+    use relume::radiosity::corners::PointTransfer;
+    use relume::radiosity::visibility::Visibility;
+    let scene = relume::scene::load_scene(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/generated/door-ajar.obj"),
+        Default::default(),
+    )
+    .unwrap()
+    .0;
+    let set = patches(&scene, Resolution::TargetPatches(800));
+    let vis = Visibility::for_patches(&scene, &set);
+    let transfer = PointTransfer::new(&scene, &set, &vis);
+    let (mut blended, mut corners) = (0, 0);
+    for t in 0..scene.triangles.len() {
+        let on = transfer.on_triangle(&scene, t);
+        for k in 0..3 {
+            let (p, w) = set.corners.list(3 * t + k);
+            if scene.is_degenerate(t) {
+                assert!(p.is_empty());
+                continue;
+            }
+            let v = scene.triangles[t][k] as usize;
+            let want = on.weights(glam::Vec3::from(scene.positions[v]));
+            let got: Vec<(u32, f32)> = p.iter().copied().zip(w.iter().copied()).collect();
+            assert_eq!(got, want, "corner {k} of triangle {t}");
+            blended += (p.len() > 1) as usize;
+            corners += 1;
+        }
+    }
+    // The scene exercises the shared searches: most positions are corners of several
+    // triangles, and many corners blend several patches.
+    assert!(corners > 3 * scene.positions.len(), "{corners} corners");
+    assert!(
+        blended > corners / 4,
+        "{blended} of {corners} corners blended"
+    );
+}
+
 #[test]
 fn transfer_is_smooth_on_a_finely_meshed_floor() {
     // A 1×1 floor meshed as 12×12 quads, voxels of 0.25: corners shared by several triangles get

@@ -77,19 +77,67 @@ pub fn patch_cells(set: &PatchSet) -> Vec<(DVec3, f64)> {
 
 /// Per-corner transfer lists (`3 * triangle + corner`) for every scene triangle; degenerate
 /// triangles get empty lists. `vis` must be built over the same grid frame as `set`.
+///
+/// Corners are weighted by position: a vertex is the corner of about six triangles, and the
+/// nearest-piece searches of a position (most of the work) are the same for all of them, so
+/// each is done once per position ([`Nearest`]). The lists are those of weighting every corner
+/// on its own, bit for bit.
 pub fn corner_patches(scene: &Scene, set: &PatchSet, vis: &Visibility) -> PatchLists {
     let transfer = PointTransfer::new(scene, set, vis);
-    let lists: Vec<[Vec<(u32, f32)>; 3]> = (0..scene.triangles.len())
-        .into_par_iter()
-        .map(|t| {
-            if scene.is_degenerate(t) {
-                return Default::default();
-            }
-            let on = transfer.on_triangle(scene, t);
-            scene.triangles[t].map(|v| on.weights(glam::Vec3::from(scene.positions[v as usize])))
+    let position = |c: usize| scene.positions[scene.triangles[c / 3][c % 3] as usize];
+    let mut corners: Vec<([u32; 3], u32)> = (0..3 * scene.triangles.len())
+        .filter(|&c| !scene.is_degenerate(c / 3))
+        .map(|c| (position(c).map(f32::to_bits), c as u32))
+        .collect();
+    corners.par_sort_unstable();
+    let groups: Vec<&[([u32; 3], u32)]> = corners.chunk_by(|a, b| a.0 == b.0).collect();
+    let weighted: Vec<(u32, Vec<(u32, f32)>)> = groups
+        .par_iter()
+        .flat_map_iter(|group| {
+            let (transfer, position) = (&transfer, &position);
+            let mut memo = Nearest::default();
+            group.iter().map(move |&(_, c)| {
+                let on = transfer.on_triangle(scene, c as usize / 3);
+                let p = glam::Vec3::from(position(c as usize));
+                (c, on.weights_with(p, &mut memo))
+            })
         })
         .collect();
-    PatchLists::from_lists(lists.into_iter().flatten().collect())
+    let mut lists = vec![Vec::new(); 3 * scene.triangles.len()];
+    for (c, list) in weighted {
+        lists[c as usize] = list;
+    }
+    PatchLists::from_lists(lists)
+}
+
+/// The nearest-piece answers at one position, kept while the corners there are weighted:
+/// [`PatchLocator::nearest`] by patch and [`PatchLocator::nearest_in_voxel`] by (voxel, axis)
+/// depend on the position alone. A few dozen entries at most (27 voxels' patches): searched
+/// in order.
+#[derive(Default)]
+struct Nearest {
+    patches: Vec<(usize, DVec3, DVec3)>,
+    voxels: Vec<([i64; 3], u8, Option<u32>)>,
+}
+
+impl Nearest {
+    fn patch(&mut self, locator: &PatchLocator, p: DVec3, j: usize) -> (DVec3, DVec3) {
+        if let Some(&(_, q, qn)) = self.patches.iter().find(|e| e.0 == j) {
+            return (q, qn);
+        }
+        let (_, q, qn) = locator.nearest(p, j);
+        self.patches.push((j, q, qn));
+        (q, qn)
+    }
+
+    fn in_voxel(&mut self, locator: &PatchLocator, p: DVec3, v: [i64; 3], axis: u8) -> Option<u32> {
+        if let Some(&(_, _, c)) = self.voxels.iter().find(|e| e.0 == v && e.1 == axis) {
+            return c;
+        }
+        let c = locator.nearest_in_voxel(p, v, axis).map(|c| c.0);
+        self.voxels.push((v, axis, c));
+        c
+    }
 }
 
 /// The transfer weights of any point on a scene triangle, by the rule of the corners: what the
@@ -150,12 +198,30 @@ impl<'a> PointTransfer<'a> {
 impl OnTriangle<'_, '_> {
     /// Weights (patch, weight summing to 1) of the point `p` (world) on the triangle.
     pub fn weights(&self, p: glam::Vec3) -> Vec<(u32, f32)> {
+        self.weights_with(p, &mut Nearest::default())
+    }
+
+    /// [`OnTriangle::weights`], with the nearest-piece answers at `p` kept in `memo` (which
+    /// must hold answers at `p` only).
+    fn weights_with(&self, p: glam::Vec3, memo: &mut Nearest) -> Vec<(u32, f32)> {
         let t = self.transfer;
-        corner_weights(t.frame.to_grid(p.to_array()), self.normal, self.centre, t)
+        corner_weights(
+            t.frame.to_grid(p.to_array()),
+            self.normal,
+            self.centre,
+            t,
+            memo,
+        )
     }
 }
 
-fn corner_weights(p: DVec3, n: DVec3, centre: DVec3, t: &PointTransfer) -> Vec<(u32, f32)> {
+fn corner_weights(
+    p: DVec3,
+    n: DVec3,
+    centre: DVec3,
+    t: &PointTransfer,
+    memo: &mut Nearest,
+) -> Vec<(u32, f32)> {
     let (locator, cells, vis, dims, lift) = (&t.locator, &t.cells, t.vis, t.dims, t.lift);
     let axis = dominant_axis(n);
     // The corner lifted off its surface and nudged into its triangle, so the leak test starts
@@ -174,9 +240,9 @@ fn corner_weights(p: DVec3, n: DVec3, centre: DVec3, t: &PointTransfer) -> Vec<(
         // adaptive split); a patch of another material, or a cluster sharing its cell, is not
         // (a threshold under a closed door does not light the floor beside it).
         let own = shared
-            .then(|| locator.nearest_in_voxel(p, voxel, axis))
+            .then(|| memo.in_voxel(locator, p, voxel, axis))
             .flatten()
-            .map(|c| c.0 as usize);
+            .map(|c| c as usize);
         for j in group {
             if let Some(k) = own {
                 if j != k && !(same_material(&t.albedo, j, k) && apart(cells[j], cells[k])) {
@@ -191,7 +257,7 @@ fn corner_weights(p: DVec3, n: DVec3, centre: DVec3, t: &PointTransfer) -> Vec<(
             if w <= 0.0 {
                 continue;
             }
-            let (_, q, qn) = locator.nearest(p, j);
+            let (q, qn) = memo.patch(locator, p, j);
             if n.dot(q - p).abs() > PLANE_DISTANCE {
                 continue;
             }
