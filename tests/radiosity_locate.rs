@@ -85,3 +85,47 @@ proptest! {
         prop_assert!(shared > 0, "no point fell in a voxel with several patches");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+    /// The nearest patch of a voxel (patches searched in the order of their runs' lower bounds,
+    /// whole patches pruned) is the first of the voxel's candidates with the least full-scan
+    /// distance, for points on and off the surfaces, in every voxel holding several patches of
+    /// one orientation.
+    #[test]
+    fn nearest_in_voxel_equals_the_least_full_scan(
+        seed in 0u64..1000,
+        offsets in prop::collection::vec(prop::array::uniform3(-0.5f64..1.5), 8),
+    ) {
+        let scene = fixtures::random_soup(300, seed);
+        let set = voxelize(
+            &scene,
+            &VoxelizeParams {
+                resolution: Resolution::VoxelSize(0.25),
+                samples_per_patch: 1,
+            },
+        )
+        .unwrap();
+        let loc = PatchLocator::new(&set, &scene);
+        let mut groups: Vec<([u32; 3], u8)> = set.patches.iter().map(|p| (p.voxel, p.axis)).collect();
+        groups.dedup();
+        let mut shared = 0;
+        for (voxel, axis) in groups {
+            let voxel = voxel.map(|v| v as i64);
+            if loc.candidates(voxel, axis).len() < 2 {
+                continue;
+            }
+            shared += 1;
+            for o in &offsets {
+                let p = DVec3::from(std::array::from_fn(|a| voxel[a] as f64 + o[a]));
+                let want = loc
+                    .candidates(voxel, axis)
+                    .map(|i| (i as u32, loc.nearest(p, i).0))
+                    .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+                let got = loc.nearest_in_voxel(p, voxel, axis).map(|c| (c.0, c.1));
+                prop_assert_eq!(got, want, "voxel {:?} axis {} point {}", voxel, axis, p);
+            }
+        }
+        prop_assert!(shared > 0, "no voxel with several patches");
+    }
+}

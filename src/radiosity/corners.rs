@@ -239,16 +239,10 @@ fn corner_weights(
         // with those of the same material in cells apart from its own (the octants of an
         // adaptive split); a patch of another material, or a cluster sharing its cell, is not
         // (a threshold under a closed door does not light the floor beside it).
-        let own = shared
-            .then(|| memo.in_voxel(locator, p, voxel, axis))
-            .flatten()
-            .map(|c| c as usize);
+        // The nearest patch is found when a patch of the group first has a weight at p: most of
+        // the 27 voxels' cells do not reach it.
+        let mut own: Option<Option<usize>> = None;
         for j in group {
-            if let Some(k) = own {
-                if j != k && !(same_material(&t.albedo, j, k) && apart(cells[j], cells[k])) {
-                    continue;
-                }
-            }
             let (lo, size) = cells[j];
             let centre = lo + DVec3::splat(0.5 * size);
             let w: f64 = (0..3)
@@ -256,6 +250,16 @@ fn corner_weights(
                 .product();
             if w <= 0.0 {
                 continue;
+            }
+            if shared {
+                let own = *own.get_or_insert_with(|| {
+                    memo.in_voxel(locator, p, voxel, axis).map(|c| c as usize)
+                });
+                if let Some(k) = own {
+                    if j != k && !(same_material(&t.albedo, j, k) && apart(cells[j], cells[k])) {
+                        continue;
+                    }
+                }
             }
             let (q, qn) = memo.patch(locator, p, j);
             if n.dot(q - p).abs() > PLANE_DISTANCE {

@@ -211,15 +211,37 @@ impl PatchLocator {
         bound: f64,
     ) -> Option<(u32, f64, DVec3)> {
         // Each patch is searched within the nearest distance found so far (a patch that cannot
-        // tie it returns ∞), which changes no answer.
+        // tie it returns ∞), which changes no answer; the patches are searched in the order of
+        // their nearest run's lower bound, so the bound tightens at the first, and a patch whose
+        // every run lies beyond it is skipped whole. Ties still go to the lower patch index:
+        // a patch that ties the nearest is never pruned, and the minimum is taken over all.
         let mut bound = bound;
-        self.candidates(voxel, axis)
-            .map(|i| {
+        let mut order: Vec<(f64, usize)> = self
+            .candidates(voxel, axis)
+            .map(|i| (self.lower_bound(p, i), i))
+            .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        order
+            .into_iter()
+            .map(|(lower, i)| {
+                if lower > bound + 1e-9 {
+                    return (i as u32, f64::INFINITY, p);
+                }
                 let (d, q, _) = self.nearest_piece(p, i, bound);
                 bound = bound.min(d);
                 (i as u32, d, q)
             })
             .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+    }
+
+    /// A lower bound of the distance from `p` to patch `i`'s pieces: the nearest of its runs'
+    /// spheres.
+    fn lower_bound(&self, p: DVec3, i: usize) -> f64 {
+        let runs = self.ranges[i].1.div_ceil(CHUNK);
+        self.chunks[self.chunk_first[i]..self.chunk_first[i] + runs]
+            .iter()
+            .map(|&(c, r)| (p - c).length() - r)
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// The patch a point `p` (grid coordinates) on a surface with dominant `axis` belongs to.
