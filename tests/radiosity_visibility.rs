@@ -85,6 +85,31 @@ fn unit(v: DVec3) -> Option<DVec3> {
 }
 
 proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// Occlusion answers do not depend on the tree (conservative traversal, exact leaf tests):
+    /// the voxel-size search builds with obvhs's medium preset and must cluster as the slowest
+    /// build would.
+    #[test]
+    fn occlusion_is_the_same_for_a_cheaper_build(
+        seed in 0u64..1000,
+        n in 1usize..400,
+        segments in prop::collection::vec((prop::array::uniform3(-0.2f64..1.2), prop::array::uniform3(-0.2f64..1.2)), 64),
+    ) {
+        let scene = random_soup(n, seed);
+        let all: Vec<u32> = (0..scene.triangles.len() as u32).collect();
+        let frame = Frame { origin: DVec3::ZERO, scale: 1.0 };
+        let best = Visibility::new(&scene, &all, &frame, 1.0);
+        let medium = Visibility::with_build(&scene, &all, &frame, 1.0, obvhs::BvhBuildParams::medium_build());
+        for (a, b) in segments {
+            let (a, b) = (DVec3::from(a), DVec3::from(b));
+            let want = best.occluded_brute_force(a, b);
+            prop_assert_eq!(best.occluded(a, b), want);
+            prop_assert_eq!(medium.occluded(a, b), want, "{} -> {}", a, b);
+        }
+    }
+}
+
+proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
     #[test]

@@ -53,6 +53,26 @@ impl Visibility {
     /// grid coordinates by `frame`. `extent` is the grid's largest dimension, which sets the
     /// ray epsilon.
     pub fn new(scene: &Scene, triangles: &[u32], frame: &Frame, extent: f64) -> Self {
+        Self::with_build(
+            scene,
+            triangles,
+            frame,
+            extent,
+            BvhBuildParams::very_slow_build(),
+        )
+    }
+
+    /// [`Visibility::new`] with obvhs's build settings `params`. Every query's answer is the
+    /// same for any tree (the traversal is conservative and the leaf tests exact), except which
+    /// of two hits at exactly the same distance a closest-hit query reports; a cheaper build
+    /// serves a few queries, the highest-quality one millions.
+    pub fn with_build(
+        scene: &Scene,
+        triangles: &[u32],
+        frame: &Frame,
+        extent: f64,
+        params: BvhBuildParams,
+    ) -> Self {
         let tris: Vec<Triangle> = triangles
             .iter()
             .map(|&t| {
@@ -69,11 +89,7 @@ impl Visibility {
         // obvhs's highest-quality preset: on the furnished room (78,324 triangles) it traces
         // 2.3x the rays per second of `slow_build` for 2x its build time (0.15 s against
         // 0.07 s), where the form-factor stage casts millions of rays (benches/visibility_embree.rs).
-        let cw = build_cwbvh_from_tris(
-            &tris,
-            BvhBuildParams::very_slow_build(),
-            &mut Duration::default(),
-        );
+        let cw = build_cwbvh_from_tris(&tris, params, &mut Duration::default());
         let bvh = WideBvh::from_cwbvh(&cw, |i| {
             let t = &tris[cw.primitive_indices[i] as usize];
             (

@@ -71,7 +71,10 @@ impl SizeSearch<'_> {
         keys.len() as u64
     }
 
-    /// Patches `voxelize` makes with voxel `size` (`u64::MAX` when the grid is too large).
+    /// Patches `voxelize` makes with voxel `size` (`u64::MAX` when the grid is too large). The
+    /// clustering asks only occlusion queries, whose answers do not depend on the tree, so each
+    /// size tried gets obvhs's medium build rather than the slowest: on the furnished room the
+    /// stage went from 2.9 to 2.5 s with `patches.bin` byte-identical.
     fn patches_at(&self, size: f64) -> u64 {
         let Some(dims) = grid_dims(self.extent, size) else {
             return u64::MAX;
@@ -82,7 +85,13 @@ impl SizeSearch<'_> {
             scale: size,
         };
         let extent_grid = dims.iter().copied().max().unwrap_or(1) as f64;
-        let vis = Visibility::new(self.scene, self.live, &frame, extent_grid);
+        let vis = Visibility::with_build(
+            self.scene,
+            self.live,
+            &frame,
+            extent_grid,
+            obvhs::BvhBuildParams::medium_build(),
+        );
         clusters(&pieces, &vis).len() as u64
     }
 
