@@ -24,6 +24,21 @@ fn disc_set() -> (Scene, PatchSet) {
     (scene, set)
 }
 
+/// A 300-triangle soup in voxels of 0.25: many voxels hold several patches of one orientation
+/// (visibility clusters).
+fn soup_set(seed: u64) -> (Scene, PatchSet) {
+    let scene = fixtures::random_soup(300, seed);
+    let set = voxelize(
+        &scene,
+        &VoxelizeParams {
+            resolution: Resolution::VoxelSize(0.25),
+            samples_per_patch: 1,
+        },
+    )
+    .unwrap();
+    (scene, set)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     /// The pruned search equals a full scan of the patch's pieces: the same distance, point and
@@ -60,15 +75,7 @@ proptest! {
         seed in 0u64..1000,
         points in prop::collection::vec((0usize..10_000, 0.0f64..1.0, 0.0f64..1.0), 200),
     ) {
-        let scene = fixtures::random_soup(300, seed);
-        let set = voxelize(
-            &scene,
-            &VoxelizeParams {
-                resolution: Resolution::VoxelSize(0.25),
-                samples_per_patch: 1,
-            },
-        )
-        .unwrap();
+        let (scene, set) = soup_set(seed);
         let loc = PatchLocator::new(&set, &scene);
         let frame = set.frame();
         let mut shared = 0;
@@ -97,15 +104,7 @@ proptest! {
         seed in 0u64..1000,
         offsets in prop::collection::vec(prop::array::uniform3(-0.5f64..1.5), 8),
     ) {
-        let scene = fixtures::random_soup(300, seed);
-        let set = voxelize(
-            &scene,
-            &VoxelizeParams {
-                resolution: Resolution::VoxelSize(0.25),
-                samples_per_patch: 1,
-            },
-        )
-        .unwrap();
+        let (scene, set) = soup_set(seed);
         let loc = PatchLocator::new(&set, &scene);
         let mut groups: Vec<([u32; 3], u8)> = set.patches.iter().map(|p| (p.voxel, p.axis)).collect();
         groups.dedup();
