@@ -398,3 +398,130 @@ proptest! {
         prop_assert!(((back as f64) - v as f64).abs() <= half_step * v as f64, "{} -> {}", v, back);
     }
 }
+
+/// The split's selection by brute force: every entry's key (largest magnitude over the
+/// channels, NaN ignored, infinite as f32::MAX), sorted by (magnitude descending, index), the
+/// first k, as (row, column) in row-major order.
+fn top_by_sorting(s: &TransportMatrix, percent: f64) -> Vec<(usize, usize)> {
+    let (n, ch) = (s.n, s.channels);
+    let k = relume::compress::split::split_count(n, percent);
+    let mut keys: Vec<(u32, usize)> = (0..n * n)
+        .map(|ij| {
+            let mag = (0..ch).fold(0.0f32, |a, c| a.max(s.data[c * n * n + ij].abs()));
+            let mag = if mag.is_finite() { mag } else { f32::MAX };
+            (!mag.to_bits(), ij)
+        })
+        .collect();
+    keys.sort_unstable();
+    let mut top: Vec<usize> = keys[..k].iter().map(|e| e.1).collect();
+    top.sort_unstable();
+    top.into_iter().map(|ij| (ij / n, ij % n)).collect()
+}
+
+fn sidecar_positions(side: &Sidecar) -> Vec<(usize, usize)> {
+    (0..side.n)
+        .flat_map(|i| side.row_cols(i).iter().map(move |&j| (i, j as usize)))
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// The split's histogram selection keeps exactly the entries a full sort keeps, ties (many
+    /// here) to the lower index, with zeros, infinities and NaN among the values.
+    #[test]
+    fn split_selects_what_a_full_sort_selects(
+        (ch, n) in (prop_oneof![Just(1usize), Just(3usize)], 1usize..24),
+        seed in any::<u64>(),
+        percent in prop_oneof![Just(0.0f64), Just(100.0f64), 0.0f64..100.0],
+    ) {
+        let pool = [0.0f32, 0.5, 1.0, 2.0, -1.0, f32::INFINITY, f32::NAN, 1e-30];
+        let mut x = seed | 1;
+        let data = (0..ch * n * n)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                pool[(x % pool.len() as u64) as usize]
+            })
+            .collect();
+        let s = TransportMatrix::new(ch, n, data).unwrap();
+        let (_, side) = split_top(&s, percent).unwrap();
+        prop_assert_eq!(sidecar_positions(&side), top_by_sorting(&s, percent));
+    }
+}
+
+/// The selection over several chunks of 2¹⁸ entries, with the k-th key in a tie class that
+/// spans them: the lowest indices of the class are taken, across the chunk boundary.
+#[test]
+fn split_ties_across_chunks_go_to_the_lower_index() {
+    let n = 700;
+    let data = (0..n * n)
+        .map(|ij| ((ij * 7 + ij / n * 13) % 5) as f32)
+        .collect();
+    let s = TransportMatrix::new(1, n, data).unwrap();
+    for percent in [0.01, 19.9, 30.0, 61.3, 99.9] {
+        let (_, side) = split_top(&s, percent).unwrap();
+        assert_eq!(
+            sidecar_positions(&side),
+            top_by_sorting(&s, percent),
+            "{percent} %"
+        );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// With hole filling, `compress` encodes the whole permuted matrix with the sidecar's
+    /// entries counting as zero: the same texture as encoding the dense part with those
+    /// entries zeroed (the copy it no longer makes), in every encoding.
+    #[test]
+    fn hole_filling_encodes_as_the_zeroed_dense_part(
+        s in matrix_strategy(),
+        percent in 0.0f64..30.0,
+        encoding in prop_oneof![
+            Just(DenseEncoding::Bc6h),
+            Just(DenseEncoding::Bc1Log),
+            Just(DenseEncoding::Bc4Log),
+            Just(DenseEncoding::F16),
+        ],
+    ) {
+        let o = EncodeOptions { fill_holes: true, ..opts(encoding) };
+        let enc = compress(&s, identity(s.n), percent, &o).unwrap();
+        let (dense_part, side) = split_top(&s, percent).unwrap();
+        let want = relume::compress::encode::encode_dense(&dense_part, &o, Some(&side)).unwrap();
+        prop_assert!(enc.dense == want);
+        prop_assert_eq!(sidecar_positions(&enc.sidecar), sidecar_positions(&side));
+    }
+}
+
+/// A row split off whole (every entry in the sidecar) has no texel that matters to copy from:
+/// hole filling must see it as the zeroed dense part does, not as its original values.
+#[test]
+fn a_row_split_off_whole_encodes_as_zeros() {
+    let n = 5;
+    let data = (0..n * n)
+        .map(|ij| {
+            if ij / n == 0 {
+                100.0 + ij as f32
+            } else {
+                0.01 * (1 + ij % 3) as f32
+            }
+        })
+        .collect();
+    let s = TransportMatrix::new(1, n, data).unwrap();
+    for encoding in [
+        DenseEncoding::Bc6h,
+        DenseEncoding::Bc4Log,
+        DenseEncoding::F16,
+    ] {
+        let o = EncodeOptions {
+            fill_holes: true,
+            ..opts(encoding)
+        };
+        let enc = compress(&s, identity(n), 20.0, &o).unwrap();
+        let (dense_part, side) = split_top(&s, 20.0).unwrap();
+        assert_eq!(side.row_cols(0).len(), n, "row 0 is the sidecar");
+        let want = relume::compress::encode::encode_dense(&dense_part, &o, Some(&side)).unwrap();
+        assert!(enc.dense == want, "{encoding:?}");
+    }
+}

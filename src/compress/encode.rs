@@ -9,14 +9,38 @@ use crate::error::{Error, Result};
 use crate::radiosity::TransportMatrix;
 use rayon::prelude::*;
 
-/// Per-channel maps for the dense part `m` (scale = the channel's largest value).
-pub fn channel_maps(m: &TransportMatrix, opts: &EncodeOptions) -> Vec<LogMap> {
-    let nn = m.n * m.n;
+/// Per-channel maps for the dense part `m` (scale = the channel's largest value), the entries
+/// in `holes` counting as zero.
+pub fn channel_maps(
+    m: &TransportMatrix,
+    opts: &EncodeOptions,
+    holes: Option<&Sidecar>,
+) -> Vec<LogMap> {
     (0..m.channels)
         .map(|c| {
-            let max = m.data[c * nn..(c + 1) * nn]
-                .par_iter()
-                .fold(|| 0.0f32, |a, &b| a.max(b))
+            let max = (0..m.n)
+                .into_par_iter()
+                .fold(
+                    || 0.0f32,
+                    |a, i| {
+                        let row = m.row(c, i);
+                        match holes {
+                            None => row.iter().fold(a, |a, &b| a.max(b)),
+                            Some(h) => {
+                                let cols = h.row_cols(i);
+                                let mut next = cols.iter().peekable();
+                                row.iter().enumerate().fold(a, |a, (j, &b)| {
+                                    if next.peek().is_some_and(|&&k| k as usize == j) {
+                                        next.next();
+                                        a
+                                    } else {
+                                        a.max(b)
+                                    }
+                                })
+                            }
+                        }
+                    },
+                )
                 .reduce(|| 0.0f32, f32::max);
             match opts.encoding {
                 DenseEncoding::F32 => LogMap {
@@ -33,12 +57,13 @@ pub fn channel_maps(m: &TransportMatrix, opts: &EncodeOptions) -> Vec<LogMap> {
         .collect()
 }
 
-/// Encode the dense part `m` (entries already split off are zero). Parallel over block rows;
-/// the output does not depend on the thread count.
+/// Encode the dense part `m` (entries already split off are zero, or listed in `holes`).
+/// Parallel over block rows; the output does not depend on the thread count.
 ///
 /// `holes` (optional) marks entries whose dense value does not matter (they were moved to the
-/// sidecar, which will hold the residual): they are filled like padding and ignored by the
-/// error feedback.
+/// sidecar, which will hold the residual): they count as zero, are filled like padding and are
+/// ignored by the error feedback. So `m` may be the whole matrix: the result is that of its
+/// dense part with the holes zeroed, without that copy.
 pub fn encode_dense(
     m: &TransportMatrix,
     opts: &EncodeOptions,
@@ -53,7 +78,7 @@ pub fn encode_dense(
     let (n, ch) = (m.n, m.channels);
     let padded = 4 * n.div_ceil(4);
     let bw = padded / 4;
-    let maps = channel_maps(m, opts);
+    let maps = channel_maps(m, opts, holes);
     let luts: Vec<[f32; 256]> = maps.iter().map(LogMap::lut).collect();
     let nl = DenseTexture::layer_count(opts.encoding, ch);
     let row_bytes = bw * opts.encoding.block_bytes();
@@ -117,6 +142,11 @@ impl Strip {
                     let i = 4 * by + y;
                     if i < n {
                         v[y * padded..y * padded + n].copy_from_slice(m.row(c, i));
+                        if let Some(h) = holes {
+                            for &j in h.row_cols(i) {
+                                v[y * padded + j as usize] = 0.0;
+                            }
+                        }
                     }
                     fill_row(
                         &mut v[y * padded..(y + 1) * padded],

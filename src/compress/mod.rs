@@ -66,8 +66,8 @@ pub fn compress(
     split_percent: f64,
     opts: &EncodeOptions,
 ) -> Result<EncodedTransport> {
-    let (dense_part, mut sidecar) = split_top(s_perm, split_percent)?;
     if !opts.fill_holes {
+        let (dense_part, sidecar) = split_top(s_perm, split_percent)?;
         let dense = encode::encode_dense(&dense_part, opts, None)?;
         return Ok(EncodedTransport {
             perm,
@@ -75,7 +75,9 @@ pub fn compress(
             sidecar,
         });
     }
-    let dense = encode::encode_dense(&dense_part, opts, Some(&sidecar))?;
+    // With hole filling the dense part is `s_perm` itself, its sidecar entries counting as zero.
+    let mut sidecar = split::top_entries(s_perm, split_percent)?;
+    let dense = encode::encode_dense(s_perm, opts, Some(&sidecar))?;
     // The sidecar holds what the dense texel at each hole lacks: S − decoded.
     let dec = dense.decoder();
     let mut vals = [[0.0f32; 16]; 3];

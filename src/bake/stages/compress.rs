@@ -136,8 +136,10 @@ impl StageRun for EncodeKnobs {
         let files = (dense * self.containers.len() as f64 + side) as u64;
         PlannedStage {
             stage: "encode".into(),
-            // Transport + permuted copy + dense part + sort keys of the split.
-            peak_bytes: 4 * n * n * (3 * ch + 2) + files,
+            // Transport + permuted copy, and a dense part only without hole filling (with it
+            // the permuted copy is encoded in place of one); the split keeps memory for its
+            // answer only (counted in `files`).
+            peak_bytes: 4 * n * n * ch * if self.fill_holes { 2 } else { 3 } + files,
             output_bytes: files,
             notes: format!(
                 "{} dense part, {} % sidecar",
