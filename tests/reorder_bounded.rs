@@ -7,7 +7,9 @@
 mod transport_box;
 
 use proptest::prelude::*;
-use relume::compress::reorder_bounded::{permute_rows_in_place, transpose_in_place};
+use relume::compress::reorder_bounded::{
+    permute_rows_in_place, permute_symmetric_in_place, transpose_in_place,
+};
 use relume::compress::{reorder, ReorderMethod, ReorderMetric, ReorderOptions};
 use relume::radiosity::TransportMatrix;
 
@@ -101,6 +103,27 @@ fn in_place_moves_undo_exactly() {
     }
     permute_rows_in_place(&mut p, &perm, true);
     assert_eq!(p, m);
+}
+
+proptest! {
+    /// `P S Pᵀ` in place (what the encode stage does instead of a copy) is `permuted`, bit for
+    /// bit, and undoing it restores S bit for bit, for any permutation (cycles of every length).
+    #[test]
+    fn symmetric_permutation_in_place_is_the_permuted_copy(
+        ch in prop_oneof![Just(1usize), Just(3usize)],
+        perm in (1usize..40).prop_flat_map(|n| Just((0..n as u32).collect::<Vec<u32>>()).prop_shuffle()),
+        seed in any::<u32>(),
+    ) {
+        let n = perm.len();
+        let data = (0..ch * n * n).map(|k| ((k as u32).wrapping_mul(2654435761) ^ seed) as f32).collect();
+        let m = TransportMatrix::new(ch, n, data).unwrap();
+        let mut p = m.clone();
+        permute_symmetric_in_place(&mut p, &perm, false);
+        let want = m.permuted(&perm);
+        prop_assert!(p.data.iter().zip(&want.data).all(|(a, b)| a.to_bits() == b.to_bits()));
+        permute_symmetric_in_place(&mut p, &perm, true);
+        prop_assert!(p.data.iter().zip(&m.data).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
 }
 
 /// The budgeted walk (the default) is an approximation: a permutation, the matrix restored, and

@@ -219,6 +219,37 @@ pub fn permute_rows_in_place(m: &mut TransportMatrix, perm: &[u32], inverse: boo
     }
 }
 
+/// `P S Pᵀ` in place: entry (k, l) becomes old entry (perm[k], perm[l]), what
+/// [`TransportMatrix::permuted`] returns, without the copy (one row of scratch per thread);
+/// `inverse` undoes it. Pure moves: undone, S comes back bit for bit.
+pub fn permute_symmetric_in_place(m: &mut TransportMatrix, perm: &[u32], inverse: bool) {
+    use rayon::prelude::*;
+    let n = m.n;
+    assert_eq!(perm.len(), n, "permutation length");
+    let columns = |m: &mut TransportMatrix| {
+        m.data.par_chunks_mut(n.max(1)).for_each_init(
+            || vec![0.0f32; n],
+            |tmp, row| {
+                tmp.copy_from_slice(row);
+                for (l, &p) in perm.iter().enumerate() {
+                    if inverse {
+                        row[p as usize] = tmp[l];
+                    } else {
+                        row[l] = tmp[p as usize];
+                    }
+                }
+            },
+        )
+    };
+    if inverse {
+        columns(m);
+        permute_rows_in_place(m, perm, true);
+    } else {
+        permute_rows_in_place(m, perm, false);
+        columns(m);
+    }
+}
+
 /// Transpose every channel of a square matrix in place (blocked; exact).
 pub fn transpose_in_place(m: &mut TransportMatrix) {
     let n = m.n;

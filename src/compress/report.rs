@@ -169,13 +169,22 @@ pub fn report(
     enc: &EncodedTransport,
     lights: &[(String, Vec<f32>)],
 ) -> CompressionReport {
+    let exact: Vec<Vec<f32>> = lights.iter().map(|(_, e)| s.mat_vec(e)).collect();
+    report_from(&exact, s_perm, enc, lights)
+}
+
+/// [`report`] given the exact gathers `exact[k] = S · lights[k]` (computed before S was
+/// permuted in place, as the encode stage does).
+pub fn report_from(
+    exact: &[Vec<f32>],
+    s_perm: &TransportMatrix,
+    enc: &EncodedTransport,
+    lights: &[(String, Vec<f32>)],
+) -> CompressionReport {
     let gather_rms_rel = lights
         .iter()
-        .map(|(name, e)| {
-            let exact = s.mat_vec(e);
-            let approx = gather(enc, e);
-            (name.clone(), rms_relative(&approx, &exact))
-        })
+        .zip(exact)
+        .map(|((name, e), exact)| (name.clone(), rms_relative(&gather(enc, e), exact)))
         .collect();
     CompressionReport {
         entry: entry_errors(s_perm, enc),

@@ -6,8 +6,10 @@ use crate::bake::workspace::Workspace;
 use crate::baked::{self, BakeTransaction, StageRecord};
 use crate::compress::compress;
 use crate::compress::dense::DenseEncoding;
-use crate::compress::reorder::reorder;
-use crate::compress::report::{report, standard_lights};
+use crate::compress::reorder::{reorder, ReorderMethod, ReorderMetric};
+use crate::compress::reorder_bounded::permute_symmetric_in_place;
+use crate::compress::reorder_bounded::{COARSE, FINE};
+use crate::compress::report::{report_from, standard_lights};
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::{EncodeKnobs, ReorderKnobs};
 use crate::progress::Progress;
@@ -41,10 +43,18 @@ impl StageRun for ReorderKnobs {
     fn estimate(&self, state: &mut PlanState) -> PlannedStage {
         let n = state.patches;
         let ch = state.channels.max(1);
+        // The bounded walks (linear metric) permute and transpose S in place and keep per row
+        // 512 f64 and 32 f32 group sums per channel; the full one (and any walk with the log
+        // metric) feature vectors, the distance matrix and a permuted copy.
+        let in_place = self.metric == ReorderMetric::Linear && self.method != ReorderMethod::Full;
+        let peak_bytes = if in_place {
+            4 * n * n * ch + (8 * FINE as u64 + 4 * COARSE as u64) * n * ch
+        } else {
+            4 * n * n * (2 * ch + 1)
+        };
         PlannedStage {
             stage: "reorder".into(),
-            // Feature vectors + distance matrix + one permuted copy.
-            peak_bytes: 4 * n * n * (2 * ch + 1),
+            peak_bytes,
             output_bytes: 12 + 4 * n,
             notes: format!("{} greedy pass(es) over {n} patches", self.passes),
         }
@@ -79,13 +89,28 @@ impl StageRun for EncodeKnobs {
             Some(p) => p,
             None => (0..s.n as u32).collect(),
         };
+        // The exact gathers of the report first; then S is permuted in place (P S Pᵀ, no
+        // copy), encoded, and restored bit for bit whatever the outcome.
+        let lights = standard_lights(s.channels, s.n);
+        let exact: Vec<Vec<f32>> = lights.iter().map(|(_, e)| s.mat_vec(e)).collect();
+        let moved = perm.iter().enumerate().any(|(k, &p)| p as usize != k);
+        let s = ws.transport_mut()?;
         progress.begin("encode", 0);
-        let s_perm = s.permuted(&perm);
-        let enc = compress(&s_perm, perm, self.split_percent, &self.options())?;
+        if moved {
+            permute_symmetric_in_place(s, &perm, false);
+        }
+        let encoded = compress(s, perm.clone(), self.split_percent, &self.options());
         progress.finish();
-        progress.begin("encode report", 0);
-        let rep = report(s, &s_perm, &enc, &standard_lights(s.channels, s.n));
-        progress.finish();
+        let rep = encoded.as_ref().ok().map(|enc| {
+            progress.begin("encode report", 0);
+            let rep = report_from(&exact, s, enc, &lights);
+            progress.finish();
+            rep
+        });
+        if moved {
+            permute_symmetric_in_place(s, &perm, true);
+        }
+        let (enc, rep) = (encoded?, rep.expect("a report of the encoding"));
         let (outputs, tiles) =
             baked::encoded::write(txn, &enc, self.max_texture_size as usize, &self.containers)?;
         let mut rec = StageRecord {
@@ -136,10 +161,10 @@ impl StageRun for EncodeKnobs {
         let files = (dense * self.containers.len() as f64 + side) as u64;
         PlannedStage {
             stage: "encode".into(),
-            // Transport + permuted copy, and a dense part only without hole filling (with it
-            // the permuted copy is encoded in place of one); the split keeps memory for its
-            // answer only (counted in `files`).
-            peak_bytes: 4 * n * n * ch * if self.fill_holes { 2 } else { 3 } + files,
+            // The transport (permuted in place), and a dense part only without hole filling
+            // (with it the permuted transport is encoded in place of one); the split keeps
+            // memory for its answer only (counted in `files`).
+            peak_bytes: 4 * n * n * ch * if self.fill_holes { 1 } else { 2 } + files,
             output_bytes: files,
             notes: format!(
                 "{} dense part, {} % sidecar",
