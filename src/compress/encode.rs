@@ -23,22 +23,16 @@ pub fn channel_maps(
                 .fold(
                     || 0.0f32,
                     |a, i| {
+                        // The row's values between its holes, in order.
                         let row = m.row(c, i);
-                        match holes {
-                            None => row.iter().fold(a, |a, &b| a.max(b)),
-                            Some(h) => {
-                                let cols = h.row_cols(i);
-                                let mut next = cols.iter().peekable();
-                                row.iter().enumerate().fold(a, |a, (j, &b)| {
-                                    if next.peek().is_some_and(|&&k| k as usize == j) {
-                                        next.next();
-                                        a
-                                    } else {
-                                        a.max(b)
-                                    }
-                                })
-                            }
+                        let holes = holes.map_or(&[][..], |h| h.row_cols(i));
+                        let mut start = 0;
+                        let mut a = a;
+                        for &j in holes {
+                            a = row[start..j as usize].iter().fold(a, |a, &b| a.max(b));
+                            start = j as usize + 1;
                         }
+                        row[start..].iter().fold(a, |a, &b| a.max(b))
                     },
                 )
                 .reduce(|| 0.0f32, f32::max);

@@ -161,9 +161,9 @@ pub fn split_top(m: &TransportMatrix, percent: f64) -> Result<(TransportMatrix, 
     let mut dense = m.clone();
     let (n, ch) = (m.n, m.channels);
     for i in 0..n {
-        for k in sidecar.row_ptr[i] as usize..sidecar.row_ptr[i + 1] as usize {
+        for &j in sidecar.row_cols(i) {
             for c in 0..ch {
-                dense.data[(c * n + i) * n + sidecar.cols[k] as usize] = 0.0;
+                dense.data[(c * n + i) * n + j as usize] = 0.0;
             }
         }
     }

@@ -153,8 +153,8 @@ impl PatchLocator {
     /// out of order, so a tie is settled by the lower piece index, as the in-order scan does.
     fn nearest_piece(&self, p: DVec3, i: usize, bound: f64) -> (f64, DVec3, usize) {
         let (first, count) = self.ranges[i];
-        let chunks = &self.chunks[self.chunk_first[i]..self.chunk_first[i] + count.div_ceil(CHUNK)];
-        let lower = |&(c, r): &(DVec3, f64)| (p - c).length() - r;
+        let chunks = self.runs(i);
+        let lower = |s: &(DVec3, f64)| beyond(p, s);
         let start = (0..chunks.len())
             .min_by(|&a, &b| lower(&chunks[a]).total_cmp(&lower(&chunks[b])))
             .unwrap_or(0);
@@ -237,11 +237,16 @@ impl PatchLocator {
     /// A lower bound of the distance from `p` to patch `i`'s pieces: the nearest of its runs'
     /// spheres.
     fn lower_bound(&self, p: DVec3, i: usize) -> f64 {
-        let runs = self.ranges[i].1.div_ceil(CHUNK);
-        self.chunks[self.chunk_first[i]..self.chunk_first[i] + runs]
+        self.runs(i)
             .iter()
-            .map(|&(c, r)| (p - c).length() - r)
+            .map(|s| beyond(p, s))
             .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The bounding spheres of patch `i`'s runs of [`CHUNK`] pieces.
+    fn runs(&self, i: usize) -> &[(DVec3, f64)] {
+        let first = self.chunk_first[i];
+        &self.chunks[first..first + self.ranges[i].1.div_ceil(CHUNK)]
     }
 
     /// The patch a point `p` (grid coordinates) on a surface with dominant `axis` belongs to.
@@ -298,6 +303,11 @@ impl PatchLocator {
     pub fn locate_hit(&self, p: DVec3, t: u32) -> Option<u32> {
         self.locate_on(p, self.triangle_axis(t), Some(t))
     }
+}
+
+/// How far `p` lies beyond a sphere (centre, radius): no point in it is nearer.
+fn beyond(p: DVec3, &(c, r): &(DVec3, f64)) -> f64 {
+    (p - c).length() - r
 }
 
 /// The voxel containing `p` (clamped into the grid).

@@ -101,16 +101,16 @@ impl StageRun for EncodeKnobs {
         }
         let encoded = compress(s, perm.clone(), self.split_percent, &self.options());
         progress.finish();
-        let rep = encoded.as_ref().ok().map(|enc| {
+        let reported = encoded.map(|enc| {
             progress.begin("encode report", 0);
-            let rep = report_from(&exact, s, enc, &lights);
+            let rep = report_from(&exact, s, &enc, &lights);
             progress.finish();
-            rep
+            (enc, rep)
         });
         if moved {
             permute_symmetric_in_place(s, &perm, true);
         }
-        let (enc, rep) = (encoded?, rep.expect("a report of the encoding"));
+        let (enc, rep) = reported?;
         let (outputs, tiles) =
             baked::encoded::write(txn, &enc, self.max_texture_size as usize, &self.containers)?;
         let mut rec = StageRecord {
