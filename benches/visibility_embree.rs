@@ -1,9 +1,15 @@
-//! relume's tracer against Embree 4 (`embreex` on PyPI, a cross-check tool) on the same rays:
-//! the exact hemisphere rays the form-factor stage casts (`hemisphere::rays`), written with the
-//! triangles to `.npy`, traced by both in the same run. Closest hit and occlusion (to the
-//! closest hit's distance, so every occluded ray is also a hit for Embree), 1 and 2 threads,
-//! Mrays/s. Scenes: the Cornell box (32 triangles), a random soup of 10,000 triangles and the
-//! bundled furnished room (78,324 triangles, `scenes/generated/furnished-room.obj`).
+//! relume's tracer against Embree 4 (`embreex` on PyPI, a cross-check tool) on the same rays,
+//! written with the triangles to `.npy` and traced by both in the same run, Mrays/s at 1 and 2
+//! threads:
+//! - the exact hemisphere rays the form-factor stage casts (`hemisphere::rays`): closest hit,
+//!   and occlusion to the closest hit's distance (so every occluded ray is also a hit for
+//!   Embree, and its occluder lies at the segment's very end);
+//! - the exact occlusion segments the pairwise estimator casts (`pairwise::pair_rays`, 16 point
+//!   pairs per patch pair, four partner patches per patch spread over the scene): occlusion
+//!   where the occluder, if any, lies anywhere between two surfaces.
+//!
+//! Scenes: the Cornell box (32 triangles), a random soup of 10,000 triangles and the bundled
+//! furnished room (78,324 triangles, `scenes/generated/furnished-room.obj`).
 //!
 //! `cargo bench --bench visibility_embree` (needs python3 with numpy and embreex: `make deps`).
 //! embreex's `scene.run` is single-threaded Embree behind a Python call: its rate includes
@@ -12,7 +18,7 @@
 #[path = "../tests/support/embree_rays.rs"]
 mod embree_rays;
 
-use embree_rays::{hemisphere_rays, write_for_embree};
+use embree_rays::{hemisphere_rays, pairwise_segments, write_for_embree, write_segments};
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
@@ -32,7 +38,11 @@ tfar = np.where(r['primID'] >= 0, r['tfar'], 1e30).astype(np.float32)
 occ = 1e30
 for _ in range(3):
     t = time.perf_counter(); scene.run(o, v, dists=np.minimum(tfar, 1e30), query='OCCLUDED'); occ = min(occ, time.perf_counter() - t)
-print(len(o) / best / 1e6, len(o) / occ / 1e6, int((r['primID'] >= 0).sum()))
+so = np.load(d + '/seg_origins.npy'); sv = np.load(d + '/seg_dirs.npy'); sl = np.load(d + '/seg_lengths.npy')
+seg = 1e30
+for _ in range(3):
+    t = time.perf_counter(); so_r = scene.run(so, sv, dists=sl, query='OCCLUDED'); seg = min(seg, time.perf_counter() - t)
+print(len(o) / best / 1e6, len(o) / occ / 1e6, int((r['primID'] >= 0).sum()), len(so) / seg / 1e6, int((np.asarray(so_r) != -1).sum()))
 "#;
 
 /// Best of three wall times of `f` in a pool of `threads`.
@@ -79,11 +89,14 @@ fn main() {
     println!("Hemisphere rays of the form-factor stage, 64 per patch; best of 3; Mrays/s\n");
     println!("| scene | triangles | rays | hits | relume closest 1 / 2 threads | Embree closest 1 thread | relume occlusion 1 / 2 threads | Embree occlusion 1 thread | relume / Embree per core (closest, occlusion) |");
     println!("|---|---|---|---|---|---|---|---|---|");
+    let mut pairs = Vec::new();
     for (name, scene, target) in scenes {
         let (ctx, rays) = hemisphere_rays(&scene, target, 64, 3);
         let dir = tmp.join(name.replace(' ', "-"));
         std::fs::create_dir_all(&dir).unwrap();
         let (_, tris) = write_for_embree(&dir, &ctx, &rays);
+        let segments = pairwise_segments(&ctx, 4, 16, 3);
+        write_segments(&dir, &segments);
         let n = rays.len() as u64;
         let hits: Vec<Option<f32>> = rays
             .par_iter()
@@ -108,6 +121,19 @@ fn main() {
             rays.len() as f64 / secs / 1e6
         };
         let (c1, c2, o1, o2) = (closest(1), closest(2), occlusion(1), occlusion(2));
+        let pair = |threads| {
+            let secs = timed(threads, || {
+                segments.par_iter().for_each(|(a, b)| {
+                    std::hint::black_box(ctx.vis.occluded(*a, *b));
+                })
+            });
+            segments.len() as f64 / secs / 1e6
+        };
+        let (p1, p2) = (pair(1), pair(2));
+        let occluded = segments
+            .par_iter()
+            .filter(|(a, b)| ctx.vis.occluded(*a, *b))
+            .count();
         let out = std::process::Command::new("python3")
             .args(["-c", EMBREE, dir.to_str().unwrap()])
             .output();
@@ -118,8 +144,8 @@ fn main() {
                 .collect(),
             _ => Vec::new(),
         };
-        let (ec, eo) = match embree.as_slice() {
-            [c, o, _] => (*c, *o),
+        let (ec, eo, ep, eocc) = match embree.as_slice() {
+            [c, o, _, p, occ] => (*c, *o, *p, *occ),
             _ => {
                 println!("| {name} | (embreex not available: `make deps-py`) |");
                 continue;
@@ -131,6 +157,17 @@ fn main() {
             c1 / ec,
             o1 / eo
         );
+        pairs.push(format!(
+            "| {name} | {} | {occluded} ({eocc}) | {p1:.2} / {p2:.2} | {ep:.2} | {:.2}x |",
+            segments.len(),
+            p1 / ep
+        ));
+    }
+    println!("\nThe pairwise estimator's occlusion segments (16 point pairs per patch pair, 4 partners per patch); Mrays/s\n");
+    println!("| scene | segments | occluded relume (Embree) | relume 1 / 2 threads | Embree 1 thread | relume / Embree per core |");
+    println!("|---|---|---|---|---|---|");
+    for p in &pairs {
+        println!("{p}");
     }
     let _ = std::fs::remove_dir_all(&tmp);
 }

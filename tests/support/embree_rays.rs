@@ -3,7 +3,7 @@
 //! `benches/visibility_embree.rs` (speed).
 
 use glam::DVec3;
-use relume::radiosity::formfactor::{hemisphere, Context};
+use relume::radiosity::formfactor::{hemisphere, pairwise, Context};
 use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 use std::path::Path;
@@ -59,4 +59,50 @@ pub fn write_for_embree(
     write("origins.npy", &[n, 3], &o);
     write("dirs.npy", &[n, 3], &d);
     (ids, tris)
+}
+
+/// The occlusion segments the pairwise estimator tests (`pairwise::pair_rays`, `k` point
+/// pairs per patch pair, random stream `seed`) for `partners` pairs per patch: patch i with
+/// the patches `(i + 1 + r·n / partners) mod n`, r = 0..partners — spread over the scene, the
+/// same pairs on every run.
+pub fn pairwise_segments(
+    ctx: &Context,
+    partners: usize,
+    k: usize,
+    seed: u64,
+) -> Vec<(DVec3, DVec3)> {
+    let n = ctx.samplers.len();
+    (0..n)
+        .flat_map(|i| {
+            (0..partners).flat_map(move |r| {
+                let j = (i + 1 + r * n / partners) % n;
+                let (i, j) = (i.min(j), i.max(j));
+                pairwise::pair_rays(ctx, i, j, k, seed)
+                    .rays
+                    .into_iter()
+                    .map(|r| (r.from, r.to))
+            })
+        })
+        .collect()
+}
+
+/// Write the segments as `seg_origins.npy`, `seg_dirs.npy` (unit, f32) and `seg_lengths.npy`
+/// into `dir`, for Embree's occlusion query from the origin to the length.
+pub fn write_segments(dir: &Path, segments: &[(DVec3, DVec3)]) {
+    let mut o = Vec::new();
+    let mut d = Vec::new();
+    let mut l = Vec::new();
+    for (from, to) in segments {
+        let delta = *to - *from;
+        o.extend(from.as_vec3().to_array());
+        d.extend(delta.normalize().as_vec3().to_array());
+        l.push(delta.length() as f32);
+    }
+    let n = segments.len() as u64;
+    let write = |f: &str, shape: &[u64], v: &[f32]| {
+        relume::baked::npy::write_npy_f32(&dir.join(f), shape, v).unwrap()
+    };
+    write("seg_origins.npy", &[n, 3], &o);
+    write("seg_dirs.npy", &[n, 3], &d);
+    write("seg_lengths.npy", &[n], &l);
 }

@@ -105,11 +105,25 @@ pub fn points_per_patch(samples: usize) -> usize {
     ((samples as f64).sqrt().floor() as usize).max(1)
 }
 
-/// `A_i F_ij` for one unordered pair.
-pub fn throughput(ctx: &Context, i: usize, j: usize, k: usize, seed: u64) -> f64 {
+/// One visibility ray of a patch pair: point `a` on i to point `b` on j, its kernel weight
+/// `cosθ_x cosθ_y / (π r² + ΔA)`, and the segment tested for occlusion (both ends lifted off
+/// their surfaces by the ray epsilon along their normals).
+#[derive(Clone, Copy, Debug)]
+pub struct PairRay {
+    pub a: usize,
+    pub b: usize,
+    pub weight: f64,
+    pub from: DVec3,
+    pub to: DVec3,
+}
+
+/// The points of pair (i, j) on each patch (position, normal) and the rays between them whose
+/// cosines are both above [`MIN_COSINE`]: what [`throughput`] traces, in its order. Empty when
+/// a patch has no area sampler.
+pub fn pair_rays(ctx: &Context, i: usize, j: usize, k: usize, seed: u64) -> PairPoints {
     let (si, sj) = (&ctx.samplers[i], &ctx.samplers[j]);
     if si.is_empty() || sj.is_empty() {
-        return 0.0;
+        return PairPoints::default();
     }
     let m = points_per_patch(k);
     let mut rng = item_rng(seed, i as u64, j as u64);
@@ -117,9 +131,7 @@ pub fn throughput(ctx: &Context, i: usize, j: usize, k: usize, seed: u64) -> f64
     let ys = points(sj, m, &mut rng);
     let disc = (si.area + sj.area) / (2.0 * (m * m) as f64);
     let lift = ctx.vis.epsilon as f64;
-    // Kernel-weighted visibility per point: (weight of visible rays, weight of all rays).
-    let mut vx = vec![(0.0, 0.0); m];
-    let mut vy = vec![(0.0, 0.0); m];
+    let mut rays = Vec::with_capacity(m * m);
     for (a, (x, nx)) in xs.iter().enumerate() {
         for (b, (y, ny)) in ys.iter().enumerate() {
             let d = *y - *x;
@@ -133,13 +145,42 @@ pub fn throughput(ctx: &Context, i: usize, j: usize, k: usize, seed: u64) -> f64
             if ci <= MIN_COSINE || cj <= MIN_COSINE {
                 continue;
             }
-            let w = ci * cj / (std::f64::consts::PI * r2 + disc);
-            let seen = !ctx.vis.occluded(*x + *nx * lift, *y + *ny * lift);
-            for acc in [&mut vx[a], &mut vy[b]] {
-                acc.1 += w;
-                if seen {
-                    acc.0 += w;
-                }
+            rays.push(PairRay {
+                a,
+                b,
+                weight: ci * cj / (std::f64::consts::PI * r2 + disc),
+                from: *x + *nx * lift,
+                to: *y + *ny * lift,
+            });
+        }
+    }
+    PairPoints { xs, ys, rays }
+}
+
+/// What [`pair_rays`] returns.
+#[derive(Default)]
+pub struct PairPoints {
+    pub xs: Vec<(DVec3, DVec3)>,
+    pub ys: Vec<(DVec3, DVec3)>,
+    pub rays: Vec<PairRay>,
+}
+
+/// `A_i F_ij` for one unordered pair.
+pub fn throughput(ctx: &Context, i: usize, j: usize, k: usize, seed: u64) -> f64 {
+    let PairPoints { xs, ys, rays } = pair_rays(ctx, i, j, k, seed);
+    if xs.is_empty() || ys.is_empty() {
+        return 0.0;
+    }
+    let (si, sj) = (&ctx.samplers[i], &ctx.samplers[j]);
+    // Kernel-weighted visibility per point: (weight of visible rays, weight of all rays).
+    let mut vx = vec![(0.0, 0.0); xs.len()];
+    let mut vy = vec![(0.0, 0.0); ys.len()];
+    for r in &rays {
+        let seen = !ctx.vis.occluded(r.from, r.to);
+        for acc in [&mut vx[r.a], &mut vy[r.b]] {
+            acc.1 += r.weight;
+            if seen {
+                acc.0 += r.weight;
             }
         }
     }
