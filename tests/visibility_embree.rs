@@ -114,18 +114,24 @@ fn compare(scene: &Scene, target: u32, k: usize, dir: &Path) -> (usize, usize, u
     (rays.len(), hits, off)
 }
 
+/// The two scenes compared: the Cornell box (32 triangles, in metres) and a random soup of
+/// 2,000 triangles.
+fn scenes() -> (Scene, Scene) {
+    let (cornell, _) = relume::scene::load_scene(
+        &repo().join("scenes/cornell-box/cornell_box.obj"),
+        relume::scene::SceneOptions { scale: 0.001 },
+    )
+    .unwrap();
+    (cornell, relume::radiosity::fixtures::random_soup(2000, 11))
+}
+
 #[test]
 fn relume_and_embree_hit_the_same_triangles_at_the_same_distances() {
     if !require_python(&["numpy", "embreex"]) {
         return;
     }
     let tmp = tempfile::tempdir().unwrap();
-    let (cornell, _) = relume::scene::load_scene(
-        &repo().join("scenes/cornell-box/cornell_box.obj"),
-        relume::scene::SceneOptions { scale: 0.001 },
-    )
-    .unwrap();
-    let soup = relume::radiosity::fixtures::random_soup(2000, 11);
+    let (cornell, soup) = scenes();
     for (name, scene, target) in [("cornell", &cornell, 400), ("soup", &soup, 2000)] {
         let dir = tmp.path().join(name);
         std::fs::create_dir(&dir).unwrap();
@@ -161,12 +167,7 @@ fn relume_and_embree_agree_on_which_pairwise_segments_are_occluded() {
         return;
     }
     let tmp = tempfile::tempdir().unwrap();
-    let (cornell, _) = relume::scene::load_scene(
-        &repo().join("scenes/cornell-box/cornell_box.obj"),
-        relume::scene::SceneOptions { scale: 0.001 },
-    )
-    .unwrap();
-    let soup = relume::radiosity::fixtures::random_soup(2000, 11);
+    let (cornell, soup) = scenes();
     for (name, scene, target) in [("cornell", &cornell, 1024), ("soup", &soup, 2000)] {
         let dir = tmp.path().join(name);
         std::fs::create_dir(&dir).unwrap();
