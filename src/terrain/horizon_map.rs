@@ -92,16 +92,16 @@ impl HorizonMap {
     ) -> HorizonMap {
         debug_assert!((1..=360).contains(&settings.directions));
         let directions = directions(settings.directions, map.cell_size);
-        // One sweeper: the map's transpose is made once for all directions that need it.
+        // One sweeper: the map's transpose is made once for all directions that need it; one
+        // scratch plane for the sweep of every direction.
         let sweeper = Sweeper::new(map);
+        let mut scratch = Vec::new();
         let angles = directions
             .iter()
             .map(|d| {
-                let plane = sweeper
-                    .sweep(d, settings.planet_radius)
-                    .par_iter()
-                    .map(|&a| encode(a as f64))
-                    .collect();
+                let plane = sweeper.sweep_map(d, settings.planet_radius, &mut scratch, |&a| {
+                    encode(a as f64)
+                });
                 progress.advance(1);
                 plane
             })

@@ -26,7 +26,7 @@ use super::horizon::{period, Direction, PeriodTexel, Stencil, Stencils};
 pub use super::horizon_hull::LANES;
 use super::horizon_hull::{atan_degrees, Hulls};
 use super::sun::Track;
-use super::sweep_bound::transpose;
+use super::sweep_bound::{transpose, transpose_map};
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -56,10 +56,36 @@ impl<'a> Sweeper<'a> {
 
     /// [`horizon_sweep`] along `dir`.
     pub fn sweep(&self, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
-        if dir.a.abs() <= dir.b.abs() {
-            return sweep_steep(self.map, dir, planet_radius);
-        }
+        self.sweep_map(dir, planet_radius, &mut Vec::new(), |&a| a)
+    }
+
+    /// [`Sweeper::sweep`] with `f` applied to every angle on the way into the returned plane
+    /// (row-major), the sweep itself writing into `scratch`. A build over many directions
+    /// passes the same scratch every time: the sweep's own plane (4 bytes a texel, the map's
+    /// size) is then allocated once, not faulted in afresh for every direction, and a
+    /// transposed direction's answer is transposed and mapped in one pass.
+    pub fn sweep_map<T: Copy + Default + Send>(
+        &self,
+        dir: &Direction,
+        planet_radius: Option<f64>,
+        scratch: &mut Vec<AtomicU32>,
+        f: impl Fn(&f32) -> T + Sync,
+    ) -> Vec<T> {
         let map = self.map;
+        let n = map.width * map.height;
+        scratch.truncate(n);
+        scratch.resize_with(n, || AtomicU32::new(0));
+        // Every texel is on exactly one lane and written once; NaN marks any that were not
+        // (the tests compare every texel with the exact horizon) rather than leaving the
+        // previous direction's angle there.
+        scratch
+            .par_iter()
+            .for_each(|v| v.store(f32::NAN.to_bits(), Ordering::Relaxed));
+        let read = |v: &AtomicU32| f(&f32::from_bits(v.load(Ordering::Relaxed)));
+        if dir.a.abs() <= dir.b.abs() {
+            sweep_steep(map, dir, planet_radius, scratch);
+            return scratch.par_iter().map(read).collect();
+        }
         let t = self.transposed.get_or_init(|| HeightMap {
             width: map.height,
             height: map.width,
@@ -73,19 +99,19 @@ impl<'a> Sweeper<'a> {
             b: dir.a,
             azimuth_deg: dir.azimuth_deg,
         };
-        let out = sweep_steep(t, &mirrored, planet_radius);
-        transpose(&out, t.width, t.height)
+        sweep_steep(t, &mirrored, planet_radius, scratch);
+        transpose_map(scratch, t.width, t.height, read)
     }
 }
 
-/// The sweep for |b| ≥ |a| on `map` itself.
-fn sweep_steep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>) -> Vec<f32> {
+/// The sweep for |b| ≥ |a| on `map` itself, into `out` (the angles' bits, row-major).
+fn sweep_steep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64>, out: &[AtomicU32]) {
     let track = dir.track(map.cell_size);
     let per = period(&track, dir);
     // The drop of a sample Δt away: κ·Δt² (t units: metres_per_t metres).
     let kappa = planet_radius.map_or(0.0, |r| track.metres_per_t.powi(2) / (2.0 * r));
     let stencils = Stencils::new(&track, dir, &per);
-    sweep_bundles(map, (dir, &track), &per, &stencils, kappa)
+    sweep_bundles(map, (dir, &track), &per, &stencils, kappa, out)
 }
 
 /// What every bundle of one direction shares.
@@ -144,16 +170,17 @@ impl Lanes {
     }
 }
 
-/// Horizon angles (degrees, row-major) of every pixel of `map` along `dir` (|b| ≥ |a|): the
-/// per-line sweep of [`super::horizon`], on bundles.
+/// Horizon angles (degrees, row-major, as f32 bits) of every pixel of `map` along `dir`
+/// (|b| ≥ |a|) into `out`: the per-line sweep of [`super::horizon`], on bundles.
 pub(super) fn sweep_bundles(
     map: &HeightMap,
     dir: (&Direction, &Track),
     per: &[PeriodTexel],
     stencils: &Stencils,
     kappa: f64,
-) -> Vec<f32> {
-    sweep_bundles_with(map, dir, per, stencils, kappa, crate::cpu::has_avx2())
+    out: &[AtomicU32],
+) {
+    sweep_bundles_with(map, dir, per, stencils, kappa, crate::cpu::has_avx2(), out)
 }
 
 /// [`sweep_bundles`] with the AVX2 kernels on or off (they give the same bits).
@@ -164,7 +191,8 @@ fn sweep_bundles_with(
     stencils: &Stencils,
     kappa: f64,
     avx2: bool,
-) -> Vec<f32> {
+    out: &[AtomicU32],
+) {
     assert!(dir.b != 0 && dir.a.abs() <= dir.b.abs());
     let (w, h) = (map.width as i64, map.height as i64);
     let plan = Plan {
@@ -199,19 +227,16 @@ fn sweep_bundles_with(
             }
         }
     }
-    let out: Vec<AtomicU32> = (0..(w * h) as usize).map(|_| AtomicU32::new(0)).collect();
+    assert_eq!(out.len(), (w * h) as usize);
     let k = per.len() - 1;
     bundles.par_chunks(8).for_each_init(
         || Lanes::new(k - 1),
         |lanes, chunk| {
             for &(r0, x0, n0, n1) in chunk {
-                bundle(&plan, lanes, (r0, x0), (n0, n1), &out);
+                bundle(&plan, lanes, (r0, x0), (n0, n1), out);
             }
         },
     );
-    out.into_iter()
-        .map(|v| f32::from_bits(v.into_inner()))
-        .collect()
 }
 
 /// The steps n ∈ [0, n_max] at which some lane of the bundle at column x₀ is on the map
@@ -480,7 +505,13 @@ mod tests {
         let track = dir.track(map.cell_size);
         let per = period(&track, dir);
         let stencils = Stencils::new(&track, dir, &per);
-        sweep_bundles_with(map, (dir, &track), &per, &stencils, kappa, avx2)
+        let out: Vec<AtomicU32> = (0..map.width * map.height)
+            .map(|_| AtomicU32::new(f32::NAN.to_bits()))
+            .collect();
+        sweep_bundles_with(map, (dir, &track), &per, &stencils, kappa, avx2, &out);
+        out.into_iter()
+            .map(|v| f32::from_bits(v.into_inner()))
+            .collect()
     }
 
     /// The steep form of a direction (the sweeper transposes the others).
