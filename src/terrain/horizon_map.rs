@@ -67,9 +67,16 @@ pub fn shadowed_f32(v0: u16, v1: u16, w: f32, elevation_deg: f32) -> bool {
 /// Degrees per quantisation step of [`HorizonMap`].
 pub const STEP_DEG: f64 = 180.0 / 65535.0;
 
-/// Quantise a horizon angle in degrees (clamped to [−90, 90]).
+/// Quantise a horizon angle in degrees (clamped to [−90, 90]; NaN gives 0).
+///
+/// The step count x = (deg + 90)/STEP_DEG lies in [0, 65535]: it is rounded half away from
+/// zero (as `f64::round`) from its integer part (the truncating conversion, exact) and its
+/// fraction (x − ⌊x⌋, exact), without libm's `round`, which this machine's baseline target
+/// calls out of line: a call per texel and direction, 2.4 % of a horizon build.
 pub fn encode(deg: f64) -> u16 {
-    ((deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG).round() as u16
+    let x = (deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG;
+    let whole = x as u32;
+    (whole + (x - whole as f64 >= 0.5) as u32) as u16
 }
 
 /// The angle in degrees of a quantised value.
@@ -210,5 +217,48 @@ impl HorizonMap {
                 v as f32
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `encode` is `f64::round` of the step count for every angle: at every step's midpoint and
+    /// the floats around it (where rounding half away from zero decides), at ±90°, beyond,
+    /// ±∞ and NaN, and at 200,000 pseudo-random angles.
+    #[test]
+    fn encode_rounds_as_f64_round() {
+        let reference = |deg: f64| ((deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG).round() as u16;
+        let mut angles = vec![
+            -90.0,
+            90.0,
+            -1e9,
+            1e9,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        for k in 0..=65535u32 {
+            let mid = (k as f64 + 0.5) * STEP_DEG - 90.0;
+            let mut x = mid;
+            for _ in 0..3 {
+                x = x.next_down();
+            }
+            for _ in 0..7 {
+                angles.push(x);
+                x = x.next_up();
+            }
+        }
+        let mut s = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..200_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            angles.push((s >> 11) as f64 / (1u64 << 53) as f64 * 200.0 - 100.0);
+        }
+        for deg in angles {
+            assert_eq!(encode(deg), reference(deg), "{deg:e}");
+        }
     }
 }

@@ -313,7 +313,13 @@ fn bundle(
                         finish(4 * g + l, (st.own.t, lanes.own[4 * g + l]), s);
                     }
                 }
-                store(&slopes, first as i64, &[Mode::Stencil; LANES], out);
+                store(
+                    &slopes,
+                    first as i64,
+                    &[Mode::Stencil; LANES],
+                    out,
+                    plan.avx2,
+                );
                 continue;
             }
             lanes.mode = [Mode::Stencil; LANES];
@@ -356,14 +362,14 @@ fn bundle(
             lanes.hulls.push(j, full);
         }
         // The bundle's first lane may lie left of the map (c0 < 0 in row 0): index in i64.
-        store(&slopes, r * w + c0, &lanes.mode, out);
+        store(&slopes, r * w + c0, &lanes.mode, out, plan.avx2);
     }
 }
 
 /// The angles (degrees) of the lanes' horizon tangents into `out` from `first` on (lane j at
 /// `first + j`), for the lanes on the map (`first` may be negative when lane 0 is not).
-fn store(slopes: &[f64; LANES], first: i64, mode: &[Mode; LANES], out: &[AtomicU32]) {
-    let degrees = atan_degrees(slopes);
+fn store(slopes: &[f64; LANES], first: i64, mode: &[Mode; LANES], out: &[AtomicU32], avx2: bool) {
+    let degrees = atan_degrees(slopes, avx2);
     for (j, (&deg, &m)) in degrees.iter().zip(mode).enumerate() {
         if m != Mode::Off {
             out[(first + j as i64) as usize].store((deg as f32).to_bits(), Ordering::Relaxed);
