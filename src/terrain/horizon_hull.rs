@@ -221,14 +221,14 @@ impl Hulls {
 
 /// atan(x) in degrees for every lane: Cephes' `atan` (S. L. Moshier; the argument reduced to
 /// |x| ≤ 0.66 by atan x = π/2 − atan(1/x) above tan(3π/8) and π/4 + atan((x − 1)/(x + 1))
-/// between, then a rational function of degree 4/5 in x²), written with selects so that the
-/// eight lanes vectorise: libm's scalar `atan` was 10 % of a horizon build. Within 2 ulp of
-/// `f64::atan` counting the round trip through degrees (the unit test), far below the f32
-/// degrees it is stored as.
+/// between, then a rational function of degree 4/5 in x²), lane by lane with selects (libm's
+/// scalar `atan` was 10 % of a horizon build). Within 2 ulp of `f64::atan` counting the round
+/// trip through degrees (the unit test), far below the f32 degrees it is stored as.
 ///
-/// With `avx2` (detected by the caller) the same code is compiled for AVX2, four lanes per
-/// instruction instead of SSE2's two: the same operations (no FMA is contracted), so the same
-/// bits.
+/// With `avx2` (detected by the caller) the same code is compiled for AVX2: the same
+/// operations (no FMA is contracted), so the same bits (the unit test compares them). The
+/// compiler still leaves the reductions' divisions scalar; an explicit four-lane version, with
+/// both reductions computed and then selected, measured no faster (docs/terrain.md).
 pub(super) fn atan_degrees(x: &[f64; LANES], avx2: bool) -> [f64; LANES] {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
