@@ -14,7 +14,7 @@
 //! `cargo bench --bench visibility_embree` (needs python3 with numpy and embreex: `make deps`).
 //! embreex's `scene.run` is single-threaded Embree behind a Python call: its rate includes
 //! copying the rays in and the results out. Closest hits are timed returning primitive ids
-//! only (`output=0`): returning t, u, v and the normal as well (`output=1`) measured 1.02-1.23x
+//! only (`output=0`): returning t, u, v and the normal as well (`output=1`) measured 1.05-1.23x
 //! slower, which is Python's copying, not Embree's tracing.
 
 #[path = "../tests/support/embree_rays.rs"]
@@ -34,7 +34,7 @@ tris = np.load(d + '/tris.npy'); o = np.load(d + '/origins.npy'); v = np.load(d 
 scene = rtcs.EmbreeScene(); TriangleMesh(scene=scene, vertices=tris)
 scene.run(o[:1000], v[:1000], output=1)  # warm-up
 # Timed with output=0 (primitive ids only): output=1 also copies t, u, v and the normal out
-# into numpy arrays, which measured 1.02-1.23x slower and is Python's cost, not Embree's.
+# into numpy arrays, which measured 1.05-1.23x slower and is Python's cost, not Embree's.
 best = 1e30
 for _ in range(3):
     t = time.perf_counter(); scene.run(o, v, output=0); best = min(best, time.perf_counter() - t)
