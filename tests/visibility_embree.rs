@@ -13,7 +13,9 @@ mod common;
 mod embree_rays;
 
 use common::{python, repo, require_python};
-use embree_rays::{hemisphere_rays, pairwise_segments, write_for_embree, write_segments};
+use embree_rays::{
+    context, hemisphere_rays, pairwise_segments, write_for_embree, write_segments, write_triangles,
+};
 use glam::Vec3;
 use relume::radiosity::visibility::BACKOFF;
 use relume::scene::Scene;
@@ -171,8 +173,8 @@ fn relume_and_embree_agree_on_which_pairwise_segments_are_occluded() {
     for (name, scene, target) in [("cornell", &cornell, 1024), ("soup", &soup, 2000)] {
         let dir = tmp.path().join(name);
         std::fs::create_dir(&dir).unwrap();
-        let (ctx, rays) = hemisphere_rays(scene, target, 1, 7);
-        write_for_embree(&dir, &ctx, &rays);
+        let ctx = context(scene, target);
+        write_triangles(&dir, &ctx);
         let segments = pairwise_segments(&ctx, 4, 16, 3);
         write_segments(&dir, &segments);
         python(EMBREE_OCCLUDED, &[dir.to_str().unwrap()]);

@@ -1,12 +1,25 @@
-//! The hemisphere rays of the form-factor stage, with the BVH's triangles, written as `.npy`
-//! for Embree (`embreex`): shared by `tests/visibility_embree.rs` (agreement) and
-//! `benches/visibility_embree.rs` (speed).
+//! The rays of the form-factor stage (hemisphere rays, pairwise segments), with the BVH's
+//! triangles, written as `.npy` for Embree (`embreex`): shared by `tests/visibility_embree.rs`
+//! (agreement) and `benches/visibility_embree.rs` (speed).
 
 use glam::DVec3;
 use relume::radiosity::formfactor::{hemisphere, pairwise, Context};
 use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 use std::path::Path;
+
+/// The form-factor context of `scene`'s patches (about `target`, one sample per patch).
+pub fn context(scene: &Scene, target: u32) -> Context {
+    let set = voxelize(
+        scene,
+        &VoxelizeParams {
+            resolution: Resolution::TargetPatches(target),
+            samples_per_patch: 1,
+        },
+    )
+    .unwrap();
+    Context::new(scene, &set)
+}
 
 /// The patches of `scene` (about `target`), their form-factor context and the `k` hemisphere
 /// rays of every patch (`hemisphere::rays`, random stream `seed`).
@@ -16,35 +29,35 @@ pub fn hemisphere_rays(
     k: usize,
     seed: u64,
 ) -> (Context, Vec<(DVec3, DVec3)>) {
-    let set = voxelize(
-        scene,
-        &VoxelizeParams {
-            resolution: Resolution::TargetPatches(target),
-            samples_per_patch: 1,
-        },
-    )
-    .unwrap();
-    let ctx = Context::new(scene, &set);
-    let rays = (0..set.len())
+    let ctx = context(scene, target);
+    let rays = (0..ctx.samplers.len())
         .flat_map(|i| hemisphere::rays(&ctx, i, k, seed))
         .collect();
     (ctx, rays)
 }
 
-/// Write `tris.npy` (`[m, 3, 3]`, the BVH's triangles in grid coordinates), `origins.npy` and
-/// `dirs.npy` (`[n, 3]`, f32) into `dir`; returns the BVH's triangles as (scene index,
-/// vertices), in the order Embree numbers them.
+/// Write `v` (f32, shape `shape`) as `name` into `dir`.
+fn write_f32(dir: &Path, name: &str, shape: &[u64], v: &[f32]) {
+    relume::baked::npy::write_npy_f32(&dir.join(name), shape, v).unwrap()
+}
+
+/// Write `tris.npy` (`[m, 3, 3]`, the BVH's triangles in grid coordinates) into `dir`; returns
+/// them as (scene index, vertices), in the order Embree numbers them.
+pub fn write_triangles(dir: &Path, ctx: &Context) -> (Vec<u32>, Vec<[[f32; 3]; 3]>) {
+    let (ids, tris): (Vec<u32>, Vec<[[f32; 3]; 3]>) = ctx.vis.triangles().unzip();
+    let flat: Vec<f32> = tris.iter().flatten().flatten().copied().collect();
+    write_f32(dir, "tris.npy", &[tris.len() as u64, 3, 3], &flat);
+    (ids, tris)
+}
+
+/// Write the triangles ([`write_triangles`]), `origins.npy` and `dirs.npy` (`[n, 3]`, f32)
+/// into `dir`; returns the triangles as [`write_triangles`] does.
 pub fn write_for_embree(
     dir: &Path,
     ctx: &Context,
     rays: &[(DVec3, DVec3)],
 ) -> (Vec<u32>, Vec<[[f32; 3]; 3]>) {
-    let write = |f: &str, shape: &[u64], v: &[f32]| {
-        relume::baked::npy::write_npy_f32(&dir.join(f), shape, v).unwrap()
-    };
-    let (ids, tris): (Vec<u32>, Vec<[[f32; 3]; 3]>) = ctx.vis.triangles().unzip();
-    let flat: Vec<f32> = tris.iter().flatten().flatten().copied().collect();
-    write("tris.npy", &[tris.len() as u64, 3, 3], &flat);
+    let triangles = write_triangles(dir, ctx);
     // Embree gets each ray from its origin in f32 (relume rounds its backed-off start to f32
     // separately: see tests/visibility_embree.rs for what that allows).
     let o: Vec<f32> = rays
@@ -56,9 +69,9 @@ pub fn write_for_embree(
         .flat_map(|(_, d)| d.as_vec3().to_array())
         .collect();
     let n = rays.len() as u64;
-    write("origins.npy", &[n, 3], &o);
-    write("dirs.npy", &[n, 3], &d);
-    (ids, tris)
+    write_f32(dir, "origins.npy", &[n, 3], &o);
+    write_f32(dir, "dirs.npy", &[n, 3], &d);
+    triangles
 }
 
 /// The occlusion segments the pairwise estimator tests (`pairwise::pair_rays`, `k` point
@@ -99,10 +112,7 @@ pub fn write_segments(dir: &Path, segments: &[(DVec3, DVec3)]) {
         l.push(delta.length() as f32);
     }
     let n = segments.len() as u64;
-    let write = |f: &str, shape: &[u64], v: &[f32]| {
-        relume::baked::npy::write_npy_f32(&dir.join(f), shape, v).unwrap()
-    };
-    write("seg_origins.npy", &[n, 3], &o);
-    write("seg_dirs.npy", &[n, 3], &d);
-    write("seg_lengths.npy", &[n], &l);
+    write_f32(dir, "seg_origins.npy", &[n, 3], &o);
+    write_f32(dir, "seg_dirs.npy", &[n, 3], &d);
+    write_f32(dir, "seg_lengths.npy", &[n], &l);
 }
