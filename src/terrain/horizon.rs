@@ -39,6 +39,7 @@
 //! ~1e-9°.
 
 use super::exact_traversal::{texel_sample, TrackWalk};
+use super::horizon_hull::LANES;
 use super::sun::{Track, TrackKind};
 use crate::heightmap::HeightMap;
 
@@ -310,6 +311,137 @@ impl Stencils {
             full,
             lo,
             hi,
+        }
+    }
+}
+
+/// The bundles of direction (a, b) (|b| ≥ |a|) over `map`: (r₀, x₀, n₀, n₁) for each bundle
+/// of [`LANES`] lines starting at row r₀ and column x₀ with some lane on the map for steps
+/// n₀ ..= n₁ (module notes: virtual lines).
+pub(super) fn bundle_list(map: &HeightMap, dir: &Direction) -> Vec<(i64, i64, i64, i64)> {
+    let (w, h) = (map.width as i64, map.height as i64);
+    let (a, b) = (dir.a, dir.b);
+    // The first rows of the lines (n = 0), on the side the walk ends at.
+    let band = if b > 0 {
+        0..b.min(h)
+    } else {
+        (h + b).max(0)..h
+    };
+    let mut bundles = Vec::new();
+    for r0 in band {
+        let n_max = if b > 0 { (h - 1 - r0) / b } else { r0 / -b };
+        let (lo, hi) = if a >= 0 {
+            (-n_max * a, w - 1)
+        } else {
+            (0, w - 1 - n_max * a)
+        };
+        for x0 in (lo..=hi).step_by(LANES) {
+            if let Some((n0, n1)) = active_span(x0, a, w, n_max) {
+                bundles.push((r0, x0, n0, n1));
+            }
+        }
+    }
+    bundles
+}
+
+/// The steps n ∈ [0, n_max] at which some lane of the bundle at column x₀ is on the map
+/// (0 ≤ x₀ + j + n·a < w for some j < LANES), or None.
+fn active_span(x0: i64, a: i64, w: i64, n_max: i64) -> Option<(i64, i64)> {
+    // n·a must lie in [lo, hi].
+    let (lo, hi) = (-(LANES as i64 - 1) - x0, w - 1 - x0);
+    let (n0, n1) = match a.signum() {
+        0 if lo <= 0 && 0 <= hi => (0, n_max),
+        0 => return None,
+        1 => (ceil_div(lo, a), hi.div_euclid(a)),
+        _ => (ceil_div(-hi, -a), (-lo).div_euclid(-a)),
+    };
+    let (n0, n1) = (n0.max(0), n1.min(n_max));
+    (n0 <= n1).then_some((n0, n1))
+}
+
+/// ⌈p / q⌉ for q > 0.
+fn ceil_div(p: i64, q: i64) -> i64 {
+    -(-p).div_euclid(q)
+}
+
+/// The exact walk's samples (t from the pixel, height) of pixel (c, r) in `period` order up to
+/// the map's edge, into `out` in push order (decreasing t); returns the own texel's half
+/// transit and the full one as the previous pixel's track crosses it (t ≈ 0).
+pub(super) fn border_walk(
+    map: &HeightMap,
+    (dir, track): (&Direction, &Track),
+    per: &[PeriodTexel],
+    (c, r): (i64, i64),
+    out: &mut Vec<(f64, f64)>,
+) -> ((f64, f64), (f64, f64)) {
+    let (w, h) = (map.width as i64, map.height as i64);
+    let inside = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h;
+    let k = per.len() - 1;
+    let p = [c as f64 + 0.5, r as f64 + 0.5];
+    let on = per[1..k]
+        .iter()
+        .take_while(|t| inside(c + t.dx, r + t.dy))
+        .count();
+    out.clear();
+    for t in per[1..=on].iter().rev() {
+        out.push(texel_sample(
+            map,
+            track,
+            p,
+            [c + t.dx, r + t.dy],
+            t.t_in,
+            t.t_out,
+        ));
+    }
+    let own = texel_sample(map, track, p, [c, r], 0.0, per[0].t_out);
+    let last = per[k];
+    let prev = [p[0] - dir.a as f64, p[1] - dir.b as f64];
+    let (tm, hq) = texel_sample(map, track, prev, [c, r], last.t_in, last.t_out);
+    let period_t = (dir.a as f64).hypot(dir.b as f64);
+    (own, (tm - period_t, hq))
+}
+
+/// Maps and directions for the sweeps' unit tests.
+#[cfg(test)]
+pub(super) mod test_maps {
+    use super::Direction;
+    use crate::heightmap::HeightMap;
+
+    /// A rough random map (spikes over smooth noise) from a seed.
+    pub fn map(w: usize, h: usize, seed: u64) -> HeightMap {
+        let mut s = seed | 1;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let heights = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32, (i / w) as f32);
+                let spike = if next() < 0.05 { 40.0 * next() } else { 0.0 };
+                10.0 * (0.3 * x).sin() * (0.2 * y).cos() + 3.0 * next() + spike + 1000.0
+            })
+            .collect();
+        HeightMap {
+            width: w,
+            height: h,
+            heights,
+            cell_size: [10.0, 10.0],
+            height_scale: 1.0,
+        }
+    }
+
+    /// The steep form of a direction (the sweeper transposes the others).
+    pub fn steep(d: Direction) -> Direction {
+        if d.a.abs() <= d.b.abs() {
+            d
+        } else {
+            Direction {
+                a: d.b,
+                b: d.a,
+                ..d
+            }
         }
     }
 }

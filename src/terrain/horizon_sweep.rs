@@ -21,15 +21,14 @@
 //! pixel is on exactly one lane; a lane is active while its pixel is on the map, which happens
 //! over one interval of n, so a lane's hull starts empty and is never reset.
 
-use super::exact_traversal::texel_sample;
-use super::horizon::{period, Direction, PeriodTexel, Stencil, Stencils};
+use super::horizon::{border_walk, bundle_list, period, Direction, PeriodTexel, Stencil, Stencils};
 pub use super::horizon_hull::LANES;
 use super::horizon_hull::{atan_degrees, Hulls};
 use super::sun::Track;
 use super::sweep_bound::{transpose, transpose_map};
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicU16, AtomicU32, Ordering};
 
 /// Horizon angles (degrees, row-major) of every pixel along `dir`, by the line sweep; on a
 /// planet of radius `planet_radius` metres when given (a sample d metres away drops by
@@ -44,6 +43,8 @@ pub fn horizon_sweep(map: &HeightMap, dir: &Direction, planet_radius: Option<f64
 pub struct Sweeper<'a> {
     map: &'a HeightMap,
     transposed: std::sync::OnceLock<HeightMap>,
+    /// For the f32 sweep: the map less its mid-range height, and that map's transpose.
+    centred: std::sync::OnceLock<(HeightMap, HeightMap)>,
 }
 
 impl<'a> Sweeper<'a> {
@@ -51,7 +52,13 @@ impl<'a> Sweeper<'a> {
         Sweeper {
             map,
             transposed: std::sync::OnceLock::new(),
+            centred: std::sync::OnceLock::new(),
         }
+    }
+
+    /// The map's transpose, made on first need.
+    fn transposed(&self) -> &HeightMap {
+        self.transposed.get_or_init(|| transposed(self.map))
     }
 
     /// [`horizon_sweep`] along `dir`.
@@ -86,13 +93,7 @@ impl<'a> Sweeper<'a> {
             sweep_steep(map, dir, planet_radius, scratch);
             return scratch.par_iter().map(read).collect();
         }
-        let t = self.transposed.get_or_init(|| HeightMap {
-            width: map.height,
-            height: map.width,
-            heights: transpose(&map.heights, map.width, map.height),
-            cell_size: [map.cell_size[1], map.cell_size[0]],
-            height_scale: map.height_scale,
-        });
+        let t = self.transposed();
         // The mirrored direction on the mirrored map: the same tracks, x and y swapped.
         let mirrored = Direction {
             a: dir.b,
@@ -102,6 +103,71 @@ impl<'a> Sweeper<'a> {
         sweep_steep(t, &mirrored, planet_radius, scratch);
         transpose_map(scratch, t.width, t.height, read)
     }
+}
+
+impl Sweeper<'_> {
+    /// The horizon map's quantised angles (u16, row-major; [`super::horizon_map::encode`]'s
+    /// steps) along `dir` by the f32 sweep ([`super::horizon_f32`]: within f32 rounding of
+    /// [`Sweeper::sweep`]). `scratch` serves the transposed directions as in
+    /// [`Sweeper::sweep_map`].
+    pub fn sweep_u16(
+        &self,
+        dir: &Direction,
+        planet_radius: Option<f64>,
+        scratch: &mut Vec<u16>,
+    ) -> Vec<u16> {
+        // Heights less their mid-range: f32 keeps a sample's height to half an ulp of the
+        // relief's half-range, not of the altitude (a 50 m relief at 3,000 m altitude).
+        let (map, t) = self.centred.get_or_init(|| {
+            let (lo, hi) = self.map.min_max();
+            let mid = (0.5 * (lo as f64 + hi as f64)) as f32;
+            let m = self.map;
+            let map = HeightMap {
+                width: m.width,
+                height: m.height,
+                heights: m.heights.iter().map(|&h| h - mid).collect(),
+                cell_size: m.cell_size,
+                height_scale: m.height_scale,
+            };
+            let t = transposed(&map);
+            (map, t)
+        });
+        let n = map.width * map.height;
+        let avx2 = crate::cpu::has_avx2();
+        if dir.a.abs() <= dir.b.abs() {
+            let mut plane = vec![0u16; n];
+            super::horizon_f32::sweep_steep_u16(map, dir, planet_radius, avx2, atomics(&mut plane));
+            return plane;
+        }
+        let mirrored = Direction {
+            a: dir.b,
+            b: dir.a,
+            azimuth_deg: dir.azimuth_deg,
+        };
+        scratch.clear();
+        scratch.resize(n, 0);
+        super::horizon_f32::sweep_steep_u16(t, &mirrored, planet_radius, avx2, atomics(scratch));
+        transpose_map(scratch, t.width, t.height, |&v| v)
+    }
+}
+
+/// The map with x and y swapped.
+fn transposed(map: &HeightMap) -> HeightMap {
+    HeightMap {
+        width: map.height,
+        height: map.width,
+        heights: transpose(&map.heights, map.width, map.height),
+        cell_size: [map.cell_size[1], map.cell_size[0]],
+        height_scale: map.height_scale,
+    }
+}
+
+/// A plane of u16 seen as atomics, for the sweep's workers to write their texels into (each
+/// texel by one lane).
+fn atomics(v: &mut [u16]) -> &[AtomicU16] {
+    // SAFETY: AtomicU16 has the size, alignment and bit validity of u16, and the exclusive
+    // borrow means no other access for the returned lifetime.
+    unsafe { &*(v as *mut [u16] as *const [AtomicU16]) }
 }
 
 /// The sweep for |b| ≥ |a| on `map` itself, into `out` (the angles' bits, row-major).
@@ -206,27 +272,7 @@ fn sweep_bundles_with(
         kappa,
         avx2,
     };
-    let (a, b) = (dir.a, dir.b);
-    // The first rows of the lines (n = 0), on the side the walk ends at.
-    let band = if b > 0 {
-        0..b.min(h)
-    } else {
-        (h + b).max(0)..h
-    };
-    let mut bundles = Vec::new();
-    for r0 in band {
-        let n_max = if b > 0 { (h - 1 - r0) / b } else { r0 / -b };
-        let (lo, hi) = if a >= 0 {
-            (-n_max * a, w - 1)
-        } else {
-            (0, w - 1 - n_max * a)
-        };
-        for x0 in (lo..=hi).step_by(LANES) {
-            if let Some((n0, n1)) = active_span(x0, a, w, n_max) {
-                bundles.push((r0, x0, n0, n1));
-            }
-        }
-    }
+    let bundles = bundle_list(map, dir);
     assert_eq!(out.len(), (w * h) as usize);
     let k = per.len() - 1;
     bundles.par_chunks(8).for_each_init(
@@ -237,26 +283,6 @@ fn sweep_bundles_with(
             }
         },
     );
-}
-
-/// The steps n ∈ [0, n_max] at which some lane of the bundle at column x₀ is on the map
-/// (0 ≤ x₀ + j + n·a < w for some j < LANES), or None.
-fn active_span(x0: i64, a: i64, w: i64, n_max: i64) -> Option<(i64, i64)> {
-    // n·a must lie in [lo, hi].
-    let (lo, hi) = (-(LANES as i64 - 1) - x0, w - 1 - x0);
-    let (n0, n1) = match a.signum() {
-        0 if lo <= 0 && 0 <= hi => (0, n_max),
-        0 => return None,
-        1 => (ceil_div(lo, a), hi.div_euclid(a)),
-        _ => (ceil_div(-hi, -a), (-lo).div_euclid(-a)),
-    };
-    let (n0, n1) = (n0.max(0), n1.min(n_max));
-    (n0 <= n1).then_some((n0, n1))
-}
-
-/// ⌈p / q⌉ for q > 0.
-fn ceil_div(p: i64, q: i64) -> i64 {
-    -(-p).div_euclid(q)
 }
 
 /// Walk one bundle from step n1 down to n0: samples for every lane (all lanes' stencils at
@@ -381,32 +407,10 @@ fn store(slopes: &[f64; LANES], first: i64, mode: &[Mode; LANES], out: &[AtomicU
 /// map: the period's texels up to the edge (the walk stops there), its own texel's half
 /// transit, and its full transit as the previous pixel's track crosses it.
 fn border_samples(plan: &Plan, (c, r): (i64, i64), j: usize, lanes: &mut Lanes) {
-    let (map, track, per) = (plan.map, &plan.track, plan.per);
-    let (w, h) = (map.width as i64, map.height as i64);
-    let inside = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h;
-    let k = per.len() - 1;
-    let p = [c as f64 + 0.5, r as f64 + 0.5];
-    let on = per[1..k]
-        .iter()
-        .take_while(|t| inside(c + t.dx, r + t.dy))
-        .count();
     let border = &mut lanes.border[j];
-    border.clear();
-    for t in per[1..=on].iter().rev() {
-        border.push(texel_sample(
-            map,
-            track,
-            p,
-            [c + t.dx, r + t.dy],
-            t.t_in,
-            t.t_out,
-        ));
-    }
-    lanes.border_own[j] = texel_sample(map, track, p, [c, r], 0.0, per[0].t_out);
-    let last = per[k];
-    let prev = [p[0] - plan.dir.a as f64, p[1] - plan.dir.b as f64];
-    let (tm, hq) = texel_sample(map, track, prev, [c, r], last.t_in, last.t_out);
-    lanes.border_full[j] = (tm - plan.period_t, hq);
+    let (own, full) = border_walk(plan.map, (&plan.dir, &plan.track), plan.per, (c, r), border);
+    lanes.border_own[j] = own;
+    lanes.border_full[j] = full;
 }
 
 /// Every stencil of the lanes' pixels, lane j at `base + j` (all taps on the map).
@@ -480,32 +484,8 @@ unsafe fn eval_avx2(st: &Stencil, hs: &[f32], base: usize, w: usize, out: &mut [
 mod tests {
     use super::*;
     use crate::terrain::horizon::directions;
+    use crate::terrain::horizon::test_maps::{map, steep};
     use proptest::prelude::*;
-
-    /// A rough random map (spikes over smooth noise) from a seed.
-    fn map(w: usize, h: usize, seed: u64) -> HeightMap {
-        let mut s = seed | 1;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let heights = (0..w * h)
-            .map(|i| {
-                let (x, y) = ((i % w) as f32, (i / w) as f32);
-                let spike = if next() < 0.05 { 40.0 * next() } else { 0.0 };
-                10.0 * (0.3 * x).sin() * (0.2 * y).cos() + 3.0 * next() + spike + 1000.0
-            })
-            .collect();
-        HeightMap {
-            width: w,
-            height: h,
-            heights,
-            cell_size: [10.0, 10.0],
-            height_scale: 1.0,
-        }
-    }
 
     fn sweep(map: &HeightMap, dir: &Direction, kappa: f64, avx2: bool) -> Vec<f32> {
         let track = dir.track(map.cell_size);
@@ -518,19 +498,6 @@ mod tests {
         out.into_iter()
             .map(|v| f32::from_bits(v.into_inner()))
             .collect()
-    }
-
-    /// The steep form of a direction (the sweeper transposes the others).
-    fn steep(d: Direction) -> Direction {
-        if d.a.abs() <= d.b.abs() {
-            d
-        } else {
-            Direction {
-                a: d.b,
-                b: d.a,
-                ..d
-            }
-        }
     }
 
     /// Found by the proptest below: in row 0 of an 8-wide map a bundle's first lanes lie left

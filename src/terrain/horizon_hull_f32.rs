@@ -1,0 +1,395 @@
+//! The upper hulls of the f32 horizon sweep ([`super::horizon_f32`]): eight lanes (adjacent
+//! lines) per AVX2 instruction, and a portable twin that runs the same f32 operations lane by
+//! lane (a proptest holds the two bit for bit equal).
+//!
+//! **One pixel step of a lane** (pixel P at τ_P on the line, f_P = z_P − κτ_P², the line's
+//! parabola as in [`super::horizon`]):
+//! 1. *Near:* the slope to P's own half transit and to each sample of its period, directly
+//!    from the times t_s of the period ((h_s − κt_s² − z_P)/t_s: no large coordinates).
+//! 2. *Far:* the tangent from (τ_P, f_P) to the hull, which holds every sample from P′ = P +
+//!    (a, b) on (at least one period away), popping the vertices before the tangent point: they
+//!    lie under the chord from P (pushed in step 4) to the tangent point, so no pixel further
+//!    back can need them (Timonen & Westerholm's amortised O(1) query).
+//! 3. *Period pushes*, in decreasing τ, of the samples above the chord from P to P′ only: a
+//!    sample under that chord is under the hull of {P, P′} and can be the tangent point of no
+//!    pixel behind P (for P itself, step 1 has it). This skips the push of most samples on
+//!    terrain that curves up between P and P′.
+//! 4. *P itself* (the full transit of its texel is its centre: a chord through a square's
+//!    centre is halved there), for the pixels behind it.
+//!
+//! The lane's answer is max(near, far) in t units (a slope per unit of τ).
+//!
+//! **Coordinates.** τ is held in fixed point (i32, 2^F units per t, F chosen by the caller so
+//! that every τ of the line fits in 2^30): differences are exact integers, turned into f32 only
+//! as differences, so a sample one period away keeps its place to 2^−F of a texel however far
+//! down the line it is. Heights are f32 (the map's own precision).
+//!
+//! **Layout of the AVX2 hulls.** Each push takes a slot (the same for every lane; a lane that
+//! does not push leaves it unused) that records, per lane, the vertex below the pushed one:
+//! its slot, height and τ. A lane's top three vertices live in registers; popping the top reads
+//! the fourth from the third one's slot (one level of gathers, whose latency the next round's
+//! test, on the top two, does not wait for). Pushes are three
+//! contiguous vector stores: no scatter.
+
+use super::horizon_hull::LANES;
+
+/// What every lane of one pixel step shares (module notes; `s` indexes the period's samples,
+/// nearest first).
+pub(super) struct Step<'a> {
+    /// τ_P in fixed point, and each period sample's τ.
+    pub xp: i32,
+    pub xs: &'a [i32],
+    /// κτ² of each sample (the drop on the line's parabola) and of P.
+    pub drop: &'a [f32],
+    pub drop_p: f32,
+    /// κt_s² and 1/t_s of each sample, and of the own half transit.
+    pub near_drop: &'a [f32],
+    pub near_inv: &'a [f32],
+    pub own_drop: f32,
+    pub own_inv: f32,
+    /// τ_P′ − τ_P as f32 (fixed point units), 2^F, and the curvature shift 2κτ_P.
+    pub dx_next: f32,
+    pub scale: f32,
+    pub shift: f32,
+}
+
+/// What each lane brings to a step.
+pub(super) struct LaneInput<'a> {
+    /// The period samples' heights less P's, [s][lane]; a lane has its first `count[lane]`
+    /// (near the map's edge, the walk's samples stop there).
+    pub heights: &'a [[f32; LANES]],
+    pub count: [i32; LANES],
+    /// The own texel's half transit (less P's height) and P's height.
+    pub own: [f32; LANES],
+    pub zp: [f32; LANES],
+    /// −1 where the lane's pixel is on the map, 0 where not.
+    pub on: [i32; LANES],
+}
+
+/// The hulls of one bundle's lanes.
+pub(super) struct HullsF32 {
+    // AVX2 layout: per slot and lane, the vertex below the one pushed there.
+    below: Vec<i32>,
+    below_y: Vec<f32>,
+    below_x: Vec<i32>,
+    slot: usize,
+    top: [[i32; LANES]; 3],
+    top_y: [[f32; LANES]; 3],
+    top_x: [[i32; LANES]; 3],
+    // Portable layout: a stack per lane.
+    stacks: [Vec<(i32, f32)>; LANES],
+    /// f_P′ of the previous step, and where its pixel was on the map.
+    f_prev: [f32; LANES],
+    prev_on: [i32; LANES],
+}
+
+impl HullsF32 {
+    pub fn new() -> HullsF32 {
+        HullsF32 {
+            below: Vec::new(),
+            below_y: Vec::new(),
+            below_x: Vec::new(),
+            slot: 1,
+            top: [[0; LANES]; 3],
+            top_y: [[0.0; LANES]; 3],
+            top_x: [[0; LANES]; 3],
+            stacks: std::array::from_fn(|_| Vec::new()),
+            f_prev: [0.0; LANES],
+            prev_on: [0; LANES],
+        }
+    }
+
+    /// Empty every lane, with room for `pushes` pushes of the AVX2 path.
+    pub fn reset(&mut self, pushes: usize) {
+        let n = (pushes + 1) * LANES;
+        if self.below.len() < n {
+            self.below.resize(n, 0);
+            self.below_y.resize(n, 0.0);
+            self.below_x.resize(n, 0);
+        }
+        // Slot 0 is the empty hull's sentinel (slot 0 below slot 0).
+        self.below[..LANES].fill(0);
+        self.slot = 1;
+        self.top = [[0; LANES]; 3];
+        self.top_y = [[0.0; LANES]; 3];
+        self.top_x = [[0; LANES]; 3];
+        self.stacks.iter_mut().for_each(Vec::clear);
+        self.prev_on = [0; LANES];
+    }
+
+    /// One pixel step of every lane; returns each lane's slope (t units; anything for lanes
+    /// off the map). With `avx2` (detected by the caller) the AVX2 kernel, else the portable
+    /// one: the same bits. A bundle must use one of them throughout.
+    #[inline(always)]
+    pub fn step(&mut self, s: &Step, l: &LaneInput, avx2: bool) -> [f32; LANES] {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            assert!(self.below.len() >= (self.slot + s.xs.len() + 1) * LANES);
+            assert!(l.heights.len() >= s.xs.len() && s.drop.len() >= s.xs.len());
+            assert!(s.near_drop.len() >= s.xs.len() && s.near_inv.len() >= s.xs.len());
+            assert!(l.count.iter().all(|&c| c >= 0 && c as usize <= s.xs.len()));
+            // SAFETY: AVX2 was detected; the asserts above give the slots and the lengths.
+            return unsafe { self.step_avx2(s, l) };
+        }
+        let _ = avx2;
+        let mut out = [0.0; LANES];
+        for (j, o) in out.iter_mut().enumerate() {
+            if l.on[j] != 0 {
+                *o = self.step_lane(s, l, j);
+            }
+        }
+        self.f_prev = std::array::from_fn(|j| l.zp[j] - s.drop_p);
+        self.prev_on = l.on;
+        out
+    }
+
+    fn step_lane(&mut self, s: &Step, l: &LaneInput, j: usize) -> f32 {
+        let (zp, count) = (l.zp[j], l.count[j] as usize);
+        let mut near = (l.own[j] - s.own_drop) * s.own_inv;
+        for i in 0..count {
+            near = near.max((l.heights[i][j] - s.near_drop[i]) * s.near_inv[i]);
+        }
+        let fp = zp - s.drop_p;
+        let stack = &mut self.stacks[j];
+        pop_while(stack, (s.xp, fp));
+        let far = match stack.last() {
+            Some(&(x1, y1)) => (y1 - fp) / (x1 - s.xp) as f32 * s.scale + s.shift,
+            None => f32::NEG_INFINITY,
+        };
+        let (prev_on, f_next) = (self.prev_on[j] != 0, self.f_prev[j]);
+        let y = |i: usize| l.heights[i][j] + (zp - s.drop[i]);
+        let dx = |i: usize| (s.xs[i] - s.xp) as f32;
+        for i in (0..count).rev() {
+            let yi = y(i);
+            // Under the chord from P to P′, or under the segment between its neighbours.
+            if prev_on && (yi - fp) * s.dx_next <= (f_next - fp) * dx(i) {
+                continue;
+            }
+            let (xl, yl) = if i == 0 {
+                (0.0, fp)
+            } else {
+                (dx(i - 1), y(i - 1))
+            };
+            let right = if i + 1 < count {
+                Some((dx(i + 1), y(i + 1)))
+            } else {
+                (prev_on && i + 1 == s.xs.len()).then_some((s.dx_next, f_next))
+            };
+            if let Some((xr, yr)) = right {
+                if (yi - yl) * (xr - xl) <= (yr - yl) * (dx(i) - xl) {
+                    continue;
+                }
+            }
+            pop_while(stack, (s.xs[i], yi));
+            stack.push((s.xs[i], yi));
+        }
+        pop_while(stack, (s.xp, fp));
+        stack.push((s.xp, fp));
+        near.max(far)
+    }
+}
+
+/// Pop the top vertex while it is not above the segment from q to the one below it (for a
+/// push), which is the same test as its slope from q being at most the next one's (for a
+/// tangent query from q).
+#[inline]
+fn pop_while(stack: &mut Vec<(i32, f32)>, (xq, yq): (i32, f32)) {
+    while let [.., (x2, y2), (x1, y1)] = stack[..] {
+        if (y1 - yq) * (x2 - xq) as f32 <= (y2 - yq) * (x1 - xq) as f32 {
+            stack.pop();
+        } else {
+            break;
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl HullsF32 {
+    /// [`HullsF32::step_lane`] for all eight lanes at once, the same operations in the same
+    /// order (no FMA).
+    ///
+    /// # Safety
+    /// AVX2 must be available; `below*` must have room for `xs.len() + 1` more slots, and the
+    /// slices of `s` and `l.heights` at least `xs.len()` entries, every count at most that.
+    #[target_feature(enable = "avx2")]
+    unsafe fn step_avx2(&mut self, s: &Step, l: &LaneInput) -> [f32; LANES] {
+        use std::arch::x86_64::*;
+        let ld_i = |a: &[i32; LANES]| _mm256_loadu_si256(a.as_ptr() as *const __m256i);
+        let ld_f = |a: &[f32; LANES]| _mm256_loadu_ps(a.as_ptr());
+        let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        let zero = _mm256_setzero_si256();
+        let (zp, on, count) = (ld_f(&l.zp), ld_i(&l.on), ld_i(&l.count));
+        // 1. Near.
+        let mut near = _mm256_mul_ps(
+            _mm256_sub_ps(ld_f(&l.own), _mm256_set1_ps(s.own_drop)),
+            _mm256_set1_ps(s.own_inv),
+        );
+        for i in 0..s.xs.len() {
+            let has = _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
+            let v = _mm256_mul_ps(
+                _mm256_sub_ps(
+                    ld_f(l.heights.get_unchecked(i)),
+                    _mm256_set1_ps(*s.near_drop.get_unchecked(i)),
+                ),
+                _mm256_set1_ps(*s.near_inv.get_unchecked(i)),
+            );
+            near = _mm256_blendv_ps(near, _mm256_max_ps(near, v), _mm256_castsi256_ps(has));
+        }
+        // The top two vertices of every lane: slot, height, τ.
+        let (mut t1, mut y1, mut x1) = (
+            ld_i(&self.top[0]),
+            ld_f(&self.top_y[0]),
+            ld_i(&self.top_x[0]),
+        );
+        let (mut t2, mut y2, mut x2) = (
+            ld_i(&self.top[1]),
+            ld_f(&self.top_y[1]),
+            ld_i(&self.top_x[1]),
+        );
+        let (mut t3, mut y3, mut x3) = (
+            ld_i(&self.top[2]),
+            ld_f(&self.top_y[2]),
+            ld_i(&self.top_x[2]),
+        );
+        let (below, below_y, below_x) = (
+            self.below.as_mut_ptr(),
+            self.below_y.as_mut_ptr(),
+            self.below_x.as_mut_ptr(),
+        );
+        // Pop, in the lanes of mask m, while the top vertex fails the test against (xq, yq).
+        macro_rules! pop_while {
+            ($m:expr, $xq:expr, $yq:expr) => {{
+                let (m, xq, yq) = ($m, $xq, $yq);
+                let mut first = true;
+                loop {
+                    let dx1 = _mm256_cvtepi32_ps(_mm256_sub_epi32(x1, xq));
+                    let dx2 = _mm256_cvtepi32_ps(_mm256_sub_epi32(x2, xq));
+                    let l = _mm256_mul_ps(_mm256_sub_ps(y1, yq), dx2);
+                    let r = _mm256_mul_ps(_mm256_sub_ps(y2, yq), dx1);
+                    let deep = _mm256_andnot_si256(_mm256_cmpeq_epi32(t2, zero), m);
+                    let pop = _mm256_and_si256(
+                        deep,
+                        _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OQ>(l, r)),
+                    );
+                    if !first && _mm256_testz_si256(pop, pop) != 0 {
+                        break;
+                    }
+                    first = false;
+                    // The third vertex moves up; the one below it comes from its slot.
+                    let popf = _mm256_castsi256_ps(pop);
+                    let idx = _mm256_add_epi32(_mm256_slli_epi32::<3>(t3), lane);
+                    let nt = _mm256_mask_i32gather_epi32::<4>(t3, below, idx, pop);
+                    let ny = _mm256_mask_i32gather_ps::<4>(y3, below_y, idx, popf);
+                    let nx = _mm256_mask_i32gather_epi32::<4>(x3, below_x, idx, pop);
+                    t1 = _mm256_blendv_epi8(t1, t2, pop);
+                    y1 = _mm256_blendv_ps(y1, y2, popf);
+                    x1 = _mm256_blendv_epi8(x1, x2, pop);
+                    t2 = _mm256_blendv_epi8(t2, t3, pop);
+                    y2 = _mm256_blendv_ps(y2, y3, popf);
+                    x2 = _mm256_blendv_epi8(x2, x3, pop);
+                    (t3, y3, x3) = (nt, ny, nx);
+                }
+            }};
+        }
+        // Push (xq, yq) in the lanes of mask m: pop, then record the vertex below in a new slot.
+        macro_rules! push {
+            ($m:expr, $xq:expr, $yq:expr) => {{
+                let (m, xq, yq) = ($m, $xq, $yq);
+                pop_while!(m, xq, yq);
+                let at = self.slot * LANES;
+                _mm256_storeu_si256(below.add(at) as *mut __m256i, t1);
+                _mm256_storeu_ps(below_y.add(at), y1);
+                _mm256_storeu_si256(below_x.add(at) as *mut __m256i, x1);
+                let mf = _mm256_castsi256_ps(m);
+                t3 = _mm256_blendv_epi8(t3, t2, m);
+                y3 = _mm256_blendv_ps(y3, y2, mf);
+                x3 = _mm256_blendv_epi8(x3, x2, m);
+                t2 = _mm256_blendv_epi8(t2, t1, m);
+                y2 = _mm256_blendv_ps(y2, y1, mf);
+                x2 = _mm256_blendv_epi8(x2, x1, m);
+                t1 = _mm256_blendv_epi8(t1, _mm256_set1_epi32(self.slot as i32), m);
+                y1 = _mm256_blendv_ps(y1, yq, mf);
+                x1 = _mm256_blendv_epi8(x1, xq, m);
+                self.slot += 1;
+            }};
+        }
+        // 2. Far: the tangent from (τ_P, f_P).
+        let xp = _mm256_set1_epi32(s.xp);
+        let fp = _mm256_sub_ps(zp, _mm256_set1_ps(s.drop_p));
+        pop_while!(on, xp, fp);
+        let far = _mm256_add_ps(
+            _mm256_mul_ps(
+                _mm256_div_ps(
+                    _mm256_sub_ps(y1, fp),
+                    _mm256_cvtepi32_ps(_mm256_sub_epi32(x1, xp)),
+                ),
+                _mm256_set1_ps(s.scale),
+            ),
+            _mm256_set1_ps(s.shift),
+        );
+        let empty = _mm256_castsi256_ps(_mm256_cmpeq_epi32(t1, zero));
+        let far = _mm256_blendv_ps(far, _mm256_set1_ps(f32::NEG_INFINITY), empty);
+        // 3. The period's samples above the chord from P to P′ (all of them where P′ is off).
+        let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
+        let rise = _mm256_sub_ps(f_next, fp);
+        let dx_next = _mm256_set1_ps(s.dx_next);
+        let k = s.xs.len();
+        let y_at = |i: usize| {
+            _mm256_add_ps(
+                ld_f(l.heights.get_unchecked(i)),
+                _mm256_sub_ps(zp, _mm256_set1_ps(*s.drop.get_unchecked(i))),
+            )
+        };
+        let dx_at = |i: usize| (*s.xs.get_unchecked(i) - s.xp) as f32;
+        let has_at = |i: usize| _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
+        // The right neighbour of the sample pushed last (nearest P′ first): P′ itself.
+        let (mut xr, mut yr, mut has_r) = (dx_next, f_next, prev_on);
+        for i in (0..k).rev() {
+            let xi = *s.xs.get_unchecked(i);
+            let (y, dxi) = (y_at(i), dx_at(i));
+            let dxv = _mm256_set1_ps(dxi);
+            let under = _mm256_cmp_ps::<_CMP_LE_OQ>(
+                _mm256_mul_ps(_mm256_sub_ps(y, fp), dx_next),
+                _mm256_mul_ps(rise, dxv),
+            );
+            let (xl, yl) = if i == 0 {
+                (_mm256_setzero_ps(), fp)
+            } else {
+                (_mm256_set1_ps(dx_at(i - 1)), y_at(i - 1))
+            };
+            let dent = _mm256_cmp_ps::<_CMP_LE_OQ>(
+                _mm256_mul_ps(_mm256_sub_ps(y, yl), _mm256_sub_ps(xr, xl)),
+                _mm256_mul_ps(_mm256_sub_ps(yr, yl), _mm256_sub_ps(dxv, xl)),
+            );
+            let skip = _mm256_or_si256(
+                _mm256_and_si256(prev_on, _mm256_castps_si256(under)),
+                _mm256_and_si256(has_r, _mm256_castps_si256(dent)),
+            );
+            let has = has_at(i);
+            (xr, yr, has_r) = (dxv, y, has);
+            let m = _mm256_andnot_si256(skip, _mm256_and_si256(has, on));
+            if _mm256_testz_si256(m, m) == 0 {
+                push!(m, _mm256_set1_epi32(xi), y);
+            }
+        }
+        // 4. P itself.
+        push!(on, xp, fp);
+        let st_i = |a: &mut [i32; LANES], v: __m256i| {
+            _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, v)
+        };
+        st_i(&mut self.top[0], t1);
+        st_i(&mut self.top[1], t2);
+        st_i(&mut self.top_x[0], x1);
+        st_i(&mut self.top_x[1], x2);
+        st_i(&mut self.top[2], t3);
+        st_i(&mut self.top_x[2], x3);
+        _mm256_storeu_ps(self.top_y[0].as_mut_ptr(), y1);
+        _mm256_storeu_ps(self.top_y[1].as_mut_ptr(), y2);
+        _mm256_storeu_ps(self.top_y[2].as_mut_ptr(), y3);
+        _mm256_storeu_ps(self.f_prev.as_mut_ptr(), fp);
+        st_i(&mut self.prev_on, on);
+        let mut out = [0.0; LANES];
+        _mm256_storeu_ps(out.as_mut_ptr(), _mm256_max_ps(near, far));
+        out
+    }
+}
