@@ -1,4 +1,5 @@
-//! Horizon maps for N azimuths, quantised to u16 (built by the line sweep, [`super::horizon_sweep`]):
+//! Horizon maps for N azimuths, quantised to u16 (built by the f32 line sweep,
+//! [`super::horizon_sweep::Sweeper::sweep_u16`]):
 //! the sky-view factor, and hard shadows for any sun in O(1) per pixel by interpolating the
 //! horizon between the two stored azimuths around the sun's (docs/algorithms.md §4.4).
 
