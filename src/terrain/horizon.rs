@@ -401,6 +401,27 @@ pub(super) fn border_walk(
     (own, (tm - period_t, hq))
 }
 
+/// Degrees per quantisation step of a horizon map ([`super::horizon_map::HorizonMap`]).
+pub const STEP_DEG: f64 = 180.0 / 65535.0;
+
+/// Quantise a horizon angle in degrees (clamped to [−90, 90]; NaN gives 0).
+///
+/// The step count x = (deg + 90)/STEP_DEG lies in [0, 65535]: it is rounded half away from
+/// zero (as `f64::round`) from its integer part (the truncating conversion, exact) and its
+/// fraction (x − ⌊x⌋, exact), without libm's `round`, which this machine's baseline target
+/// calls out of line: a call per texel and direction, 2.4 % of a horizon build.
+#[inline]
+pub fn encode(deg: f64) -> u16 {
+    let x = (deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG;
+    let whole = x as u32;
+    (whole + (x - whole as f64 >= 0.5) as u32) as u16
+}
+
+/// The angle in degrees of a quantised value.
+pub fn decode(v: u16) -> f64 {
+    -90.0 + v as f64 * STEP_DEG
+}
+
 /// Maps and directions for the sweeps' unit tests.
 #[cfg(test)]
 pub(super) mod test_maps {

@@ -10,11 +10,11 @@
 //! **Precondition:** a direction (a, b) with |b| ≥ |a| (b ≠ 0), as for the f64 bundles;
 //! [`super::horizon_sweep::Sweeper`] transposes the map for the others.
 
+use super::horizon::encode;
 use super::horizon::{border_walk, bundle_list};
 use super::horizon::{period, Direction, Stencil, Stencils};
 use super::horizon_hull::LANES;
 use super::horizon_hull_f32::{HullsF32, LaneInput, Step};
-use super::horizon_map::encode;
 use crate::heightmap::HeightMap;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU16, Ordering};

@@ -236,21 +236,12 @@ impl HullsF32 {
             near = _mm256_blendv_ps(near, _mm256_max_ps(near, v), _mm256_castsi256_ps(has));
         }
         // The top two vertices of every lane: slot, height, τ.
-        let (mut t1, mut y1, mut x1) = (
-            ld_i(&self.top[0]),
-            ld_f(&self.top_y[0]),
-            ld_i(&self.top_x[0]),
-        );
-        let (mut t2, mut y2, mut x2) = (
-            ld_i(&self.top[1]),
-            ld_f(&self.top_y[1]),
-            ld_i(&self.top_x[1]),
-        );
-        let (mut t3, mut y3, mut x3) = (
-            ld_i(&self.top[2]),
-            ld_f(&self.top_y[2]),
-            ld_i(&self.top_x[2]),
-        );
+        let top = |k: usize| Top {
+            slot: ld_i(&self.top[k]),
+            y: ld_f(&self.top_y[k]),
+            x: ld_i(&self.top_x[k]),
+        };
+        let (mut v1, mut v2, mut v3) = (top(0), top(1), top(2));
         let (below, below_y, below_x) = (
             self.below.as_mut_ptr(),
             self.below_y.as_mut_ptr(),
@@ -262,11 +253,11 @@ impl HullsF32 {
                 let (m, xq, yq) = ($m, $xq, $yq);
                 let mut first = true;
                 loop {
-                    let dx1 = _mm256_cvtepi32_ps(_mm256_sub_epi32(x1, xq));
-                    let dx2 = _mm256_cvtepi32_ps(_mm256_sub_epi32(x2, xq));
-                    let l = _mm256_mul_ps(_mm256_sub_ps(y1, yq), dx2);
-                    let r = _mm256_mul_ps(_mm256_sub_ps(y2, yq), dx1);
-                    let deep = _mm256_andnot_si256(_mm256_cmpeq_epi32(t2, zero), m);
+                    let dx1 = _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xq));
+                    let dx2 = _mm256_cvtepi32_ps(_mm256_sub_epi32(v2.x, xq));
+                    let l = _mm256_mul_ps(_mm256_sub_ps(v1.y, yq), dx2);
+                    let r = _mm256_mul_ps(_mm256_sub_ps(v2.y, yq), dx1);
+                    let deep = _mm256_andnot_si256(_mm256_cmpeq_epi32(v2.slot, zero), m);
                     let pop = _mm256_and_si256(
                         deep,
                         _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OQ>(l, r)),
@@ -277,17 +268,13 @@ impl HullsF32 {
                     first = false;
                     // The third vertex moves up; the one below it comes from its slot.
                     let popf = _mm256_castsi256_ps(pop);
-                    let idx = _mm256_add_epi32(_mm256_slli_epi32::<3>(t3), lane);
-                    let nt = _mm256_mask_i32gather_epi32::<4>(t3, below, idx, pop);
-                    let ny = _mm256_mask_i32gather_ps::<4>(y3, below_y, idx, popf);
-                    let nx = _mm256_mask_i32gather_epi32::<4>(x3, below_x, idx, pop);
-                    t1 = _mm256_blendv_epi8(t1, t2, pop);
-                    y1 = _mm256_blendv_ps(y1, y2, popf);
-                    x1 = _mm256_blendv_epi8(x1, x2, pop);
-                    t2 = _mm256_blendv_epi8(t2, t3, pop);
-                    y2 = _mm256_blendv_ps(y2, y3, popf);
-                    x2 = _mm256_blendv_epi8(x2, x3, pop);
-                    (t3, y3, x3) = (nt, ny, nx);
+                    let idx = _mm256_add_epi32(_mm256_slli_epi32::<3>(v3.slot), lane);
+                    let v4 = Top {
+                        slot: _mm256_mask_i32gather_epi32::<4>(v3.slot, below, idx, pop),
+                        y: _mm256_mask_i32gather_ps::<4>(v3.y, below_y, idx, popf),
+                        x: _mm256_mask_i32gather_epi32::<4>(v3.x, below_x, idx, pop),
+                    };
+                    (v1, v2, v3) = (pick(v1, v2, pop), pick(v2, v3, pop), v4);
                 }
             }};
         }
@@ -297,19 +284,15 @@ impl HullsF32 {
                 let (m, xq, yq) = ($m, $xq, $yq);
                 pop_while!(m, xq, yq);
                 let at = self.slot * LANES;
-                _mm256_storeu_si256(below.add(at) as *mut __m256i, t1);
-                _mm256_storeu_ps(below_y.add(at), y1);
-                _mm256_storeu_si256(below_x.add(at) as *mut __m256i, x1);
-                let mf = _mm256_castsi256_ps(m);
-                t3 = _mm256_blendv_epi8(t3, t2, m);
-                y3 = _mm256_blendv_ps(y3, y2, mf);
-                x3 = _mm256_blendv_epi8(x3, x2, m);
-                t2 = _mm256_blendv_epi8(t2, t1, m);
-                y2 = _mm256_blendv_ps(y2, y1, mf);
-                x2 = _mm256_blendv_epi8(x2, x1, m);
-                t1 = _mm256_blendv_epi8(t1, _mm256_set1_epi32(self.slot as i32), m);
-                y1 = _mm256_blendv_ps(y1, yq, mf);
-                x1 = _mm256_blendv_epi8(x1, xq, m);
+                _mm256_storeu_si256(below.add(at) as *mut __m256i, v1.slot);
+                _mm256_storeu_ps(below_y.add(at), v1.y);
+                _mm256_storeu_si256(below_x.add(at) as *mut __m256i, v1.x);
+                let q = Top {
+                    slot: _mm256_set1_epi32(self.slot as i32),
+                    y: yq,
+                    x: xq,
+                };
+                (v1, v2, v3) = (pick(v1, q, m), pick(v2, v1, m), pick(v3, v2, m));
                 self.slot += 1;
             }};
         }
@@ -320,14 +303,14 @@ impl HullsF32 {
         let far = _mm256_add_ps(
             _mm256_mul_ps(
                 _mm256_div_ps(
-                    _mm256_sub_ps(y1, fp),
-                    _mm256_cvtepi32_ps(_mm256_sub_epi32(x1, xp)),
+                    _mm256_sub_ps(v1.y, fp),
+                    _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xp)),
                 ),
                 _mm256_set1_ps(s.scale),
             ),
             _mm256_set1_ps(s.shift),
         );
-        let empty = _mm256_castsi256_ps(_mm256_cmpeq_epi32(t1, zero));
+        let empty = _mm256_castsi256_ps(_mm256_cmpeq_epi32(v1.slot, zero));
         let far = _mm256_blendv_ps(far, _mm256_set1_ps(f32::NEG_INFINITY), empty);
         // 3. The period's samples above the chord from P to P′ (all of them where P′ is off).
         let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
@@ -377,19 +360,37 @@ impl HullsF32 {
         let st_i = |a: &mut [i32; LANES], v: __m256i| {
             _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, v)
         };
-        st_i(&mut self.top[0], t1);
-        st_i(&mut self.top[1], t2);
-        st_i(&mut self.top_x[0], x1);
-        st_i(&mut self.top_x[1], x2);
-        st_i(&mut self.top[2], t3);
-        st_i(&mut self.top_x[2], x3);
-        _mm256_storeu_ps(self.top_y[0].as_mut_ptr(), y1);
-        _mm256_storeu_ps(self.top_y[1].as_mut_ptr(), y2);
-        _mm256_storeu_ps(self.top_y[2].as_mut_ptr(), y3);
+        for (k, v) in [v1, v2, v3].into_iter().enumerate() {
+            st_i(&mut self.top[k], v.slot);
+            st_i(&mut self.top_x[k], v.x);
+            _mm256_storeu_ps(self.top_y[k].as_mut_ptr(), v.y);
+        }
         _mm256_storeu_ps(self.f_prev.as_mut_ptr(), fp);
         st_i(&mut self.prev_on, on);
         let mut out = [0.0; LANES];
         _mm256_storeu_ps(out.as_mut_ptr(), _mm256_max_ps(near, far));
         out
+    }
+}
+
+/// One vertex of each of the eight lanes: its slot, height and τ.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+struct Top {
+    slot: std::arch::x86_64::__m256i,
+    y: std::arch::x86_64::__m256,
+    x: std::arch::x86_64::__m256i,
+}
+
+/// `b` in the lanes of mask `m`, else `a`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn pick(a: Top, b: Top, m: std::arch::x86_64::__m256i) -> Top {
+    use std::arch::x86_64::*;
+    Top {
+        slot: _mm256_blendv_epi8(a.slot, b.slot, m),
+        y: _mm256_blendv_ps(a.y, b.y, _mm256_castsi256_ps(m)),
+        x: _mm256_blendv_epi8(a.x, b.x, m),
     }
 }

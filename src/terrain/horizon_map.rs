@@ -3,6 +3,7 @@
 //! the sky-view factor, and hard shadows for any sun in O(1) per pixel by interpolating the
 //! horizon between the two stored azimuths around the sun's (docs/algorithms.md §4.4).
 
+pub use super::horizon::{decode, encode, STEP_DEG};
 use super::horizon::{directions, Direction};
 use super::horizon_sweep::Sweeper;
 use crate::heightmap::HeightMap;
@@ -63,27 +64,6 @@ pub fn shadowed_f32(v0: u16, v1: u16, w: f32, elevation_deg: f32) -> bool {
     let step = STEP_DEG as f32;
     let (h0, h1) = (v0 as f32 * step - 90.0, v1 as f32 * step - 90.0);
     elevation_deg < h0 + (h1 - h0) * w
-}
-
-/// Degrees per quantisation step of [`HorizonMap`].
-pub const STEP_DEG: f64 = 180.0 / 65535.0;
-
-/// Quantise a horizon angle in degrees (clamped to [−90, 90]; NaN gives 0).
-///
-/// The step count x = (deg + 90)/STEP_DEG lies in [0, 65535]: it is rounded half away from
-/// zero (as `f64::round`) from its integer part (the truncating conversion, exact) and its
-/// fraction (x − ⌊x⌋, exact), without libm's `round`, which this machine's baseline target
-/// calls out of line: a call per texel and direction, 2.4 % of a horizon build.
-#[inline]
-pub fn encode(deg: f64) -> u16 {
-    let x = (deg.clamp(-90.0, 90.0) + 90.0) / STEP_DEG;
-    let whole = x as u32;
-    (whole + (x - whole as f64 >= 0.5) as u32) as u16
-}
-
-/// The angle in degrees of a quantised value.
-pub fn decode(v: u16) -> f64 {
-    -90.0 + v as f64 * STEP_DEG
 }
 
 impl HorizonMap {
