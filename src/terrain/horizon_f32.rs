@@ -55,8 +55,9 @@ struct Plan<'a> {
     near_inv: Vec<f32>,
     period_t: f64,
     kappa: f64,
-    /// Fixed-point units per t (2^F).
+    /// Fixed-point units per t (2^F), and each period sample's t in them.
     units: f64,
+    offsets: Vec<i32>,
     avx2: bool,
 }
 
@@ -74,7 +75,7 @@ impl<'a> Plan<'a> {
             .log2()
             .floor()
             .clamp(0.0, 24.0);
-        Plan {
+        let mut plan = Plan {
             map,
             dir: *dir,
             track,
@@ -87,7 +88,10 @@ impl<'a> Plan<'a> {
             kappa,
             units: 2f64.powi(bits as i32),
             avx2,
-        }
+            offsets: Vec::new(),
+        };
+        plan.offsets = plan.ts.iter().map(|&t| plan.fixed(t)).collect();
+        plan
     }
 
     /// τ ≥ 0 to the nearest fixed-point unit (halves up; no libm call).
@@ -165,9 +169,13 @@ fn bundle_lanes(
         let c0 = x0 + n * plan.dir.a;
         let tau = n as f64 * plan.period_t;
         let xp = plan.fixed(tau);
-        for (i, &t) in plan.ts.iter().enumerate() {
-            sc.xs[i] = plan.fixed(tau + t);
-            sc.drop[i] = (kappa * (tau + t) * (tau + t)) as f32;
+        for (x, &off) in sc.xs.iter_mut().zip(&plan.offsets) {
+            *x = xp + off;
+        }
+        if kappa != 0.0 {
+            for (d, &t) in sc.drop.iter_mut().zip(&plan.ts) {
+                *d = (kappa * (tau + t) * (tau + t)) as f32;
+            }
         }
         let rows_fit = r + st.lo[1] >= 0 && r + st.hi[1] < h;
         let all_fit = rows_fit && c0 + st.lo[0] >= 0 && c0 + LANES as i64 - 1 + st.hi[0] < w;
