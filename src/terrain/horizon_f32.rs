@@ -5,7 +5,8 @@
 //! out. The f64 sweep is the exact reference (bit for bit the per-pixel walk up to rounding);
 //! this one is what [`super::horizon_map::HorizonMap::build`] runs. Its error against the exact
 //! horizon is measured in `tests/terrain_horizon.rs` and docs/terrain.md: f32 rounding of the
-//! samples and of the slopes, far below the u16 step (0.0027°).
+//! samples and of the slopes, 3e-5° on Puget Sound 4096² (the u16 step is 0.0027°), up to
+//! 2e-3° next to a synthetic 178 m cliff between half-metre texels.
 //!
 //! **Precondition:** a direction (a, b) with |b| ≥ |a| (b ≠ 0), as for the f64 bundles;
 //! [`super::horizon_sweep::Sweeper`] transposes the map for the others.
