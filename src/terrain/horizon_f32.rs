@@ -206,10 +206,7 @@ fn bundle_lanes(
                 let z = hs[pixel];
                 input.zp[j] = z;
                 if rows_fit && c + st.lo[0] >= 0 && c + st.hi[0] < w {
-                    for (s, stencil) in st.period.iter().enumerate() {
-                        sc.heights[s][j] = eval_f32(stencil, hs, pixel, map.width, z);
-                    }
-                    input.own[j] = eval_f32(&st.own, hs, pixel, map.width, z);
+                    eval_lane(plan, pixel, z, j, &mut sc.heights, &mut input.own);
                     input.count[j] = k as i32;
                 } else {
                     let dt = (&plan.dir, &plan.track);
@@ -238,7 +235,7 @@ fn bundle_lanes(
             shift: (2.0 * kappa * tau) as f32,
         };
         let slopes = sc.hulls.step(&step, &input, plan.avx2);
-        let q = quantise(&slopes, inv_m, plan.avx2);
+        let q = quantise(&slopes, inv_m);
         let first = r * w + c0;
         for j in 0..LANES {
             if input.on[j] != 0 {
@@ -284,12 +281,26 @@ fn eval_lanes(
         }
         return;
     }
-    for j in 0..LANES {
-        for (s, stencil) in st.period.iter().enumerate() {
-            heights[s][j] = eval_f32(stencil, hs, base + j, w, z[j]);
-        }
-        own[j] = eval_f32(&st.own, hs, base + j, w, z[j]);
+    for (j, &zj) in z.iter().enumerate() {
+        eval_lane(plan, base + j, zj, j, heights, own);
     }
+}
+
+/// Every stencil of lane j's pixel (all its taps on the map), relative to its height `z`.
+#[inline(always)]
+fn eval_lane(
+    plan: &Plan,
+    pixel: usize,
+    z: f32,
+    j: usize,
+    heights: &mut [[f32; LANES]],
+    own: &mut [f32; LANES],
+) {
+    let (hs, w, st) = (&plan.map.heights[..], plan.map.width, &plan.stencils);
+    for (s, stencil) in st.period.iter().enumerate() {
+        heights[s][j] = eval_f32(stencil, hs, pixel, w, z);
+    }
+    own[j] = eval_f32(&st.own, hs, pixel, w, z);
 }
 
 /// [`eval_f32`] of lanes `base + j`, eight at a time: the same operations, the same bits.
@@ -327,27 +338,10 @@ unsafe fn eval_avx2(
 
 /// Slopes (t units) to the horizon map's u16: atan of slope/metres_per_t in degrees
 /// ([`atan_f32`]), then [`encode`]'s step (in f64: flat ground's 0° is the exact half step
-/// 32767.5, rounded up as the f64 sweep's map rounds it).
+/// 32767.5, rounded up as the f64 sweep's map rounds it). Inlined into the bundle's walk, which
+/// is compiled for AVX2 where detected.
 #[inline(always)]
-fn quantise(slopes: &[f32; LANES], inv_m: f32, avx2: bool) -> [u16; LANES] {
-    #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        // SAFETY: the caller detected AVX2.
-        return unsafe { quantise_avx2(slopes, inv_m) };
-    }
-    let _ = avx2;
-    quantise_lanes(slopes, inv_m)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-unsafe fn quantise_avx2(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
-    quantise_lanes(slopes, inv_m)
-}
-
-#[inline(always)]
-fn quantise_lanes(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
+fn quantise(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
     let mut out = [0u16; LANES];
     for (o, &s) in out.iter_mut().zip(slopes) {
         let deg = atan_f32(s * inv_m) * (180.0 / std::f32::consts::PI);
