@@ -8,6 +8,10 @@
 //!   pairs per patch pair, four partner patches per patch spread over the scene): occlusion
 //!   where the occluder, if any, lies anywhere between two surfaces.
 //!
+//! relume traces the same f32 rays Embree gets (`Ray::from_f32`: origin, direction and length
+//! as written to the `.npy` files). A third table times the stage's own entry points on the
+//! same rays, which take f64 origins and endpoints and round them per call.
+//!
 //! Scenes: the Cornell box (32 triangles), a random soup of 10,000 triangles and the bundled
 //! furnished room (78,324 triangles, `scenes/generated/furnished-room.obj`).
 //!
@@ -20,8 +24,11 @@
 #[path = "../tests/support/embree_rays.rs"]
 mod embree_rays;
 
-use embree_rays::{hemisphere_rays, pairwise_segments, write_for_embree, write_segments};
+use embree_rays::{
+    f32_rays, f32_segments, hemisphere_rays, pairwise_segments, write_for_embree, write_segments,
+};
 use rayon::prelude::*;
+use relume::radiosity::visibility::Ray;
 use std::path::Path;
 use std::time::Instant;
 
@@ -95,6 +102,7 @@ fn main() {
     println!("| scene | triangles | rays | hits | relume closest 1 / 2 threads | Embree closest 1 thread | relume occlusion 1 / 2 threads | Embree occlusion 1 thread | relume / Embree per core (closest, occlusion) |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut pairs = Vec::new();
+    let mut stage = Vec::new();
     for (name, scene, target) in scenes {
         let (ctx, rays) = hemisphere_rays(&scene, target, 64, 3);
         let dir = tmp.join(name.replace(' ', "-"));
@@ -103,42 +111,72 @@ fn main() {
         let segments = pairwise_segments(&ctx, 4, 16, 3);
         write_segments(&dir, &segments);
         let n = rays.len() as u64;
-        let hits: Vec<Option<f32>> = rays
+        // The f32 rays as Embree gets them; occlusion up to relume's own closest hit (Embree's
+        // occlusion goes up to its own).
+        let rays32: Vec<Ray> = f32_rays(&rays)
+            .into_iter()
+            .map(|(o, d)| Ray::from_f32(o, d, f32::INFINITY))
+            .collect();
+        let hits: Vec<Option<f32>> = rays32
             .par_iter()
-            .map(|(o, d)| ctx.vis.closest_hit(*o, *d).map(|h| h.t))
+            .map(|r| ctx.vis.trace_closest(r).map(|h| h.t))
             .collect();
         let hit_count = hits.iter().flatten().count();
-        let closest = |threads| {
+        let cut32: Vec<Ray> = f32_rays(&rays)
+            .into_iter()
+            .zip(&hits)
+            .map(|((o, d), h)| Ray::from_f32(o, d, h.unwrap_or(1e3)))
+            .collect();
+        let segs32: Vec<Ray> = f32_segments(&segments)
+            .into_iter()
+            .map(|(o, d, l)| Ray::from_f32(o, d, l))
+            .collect();
+        let rate = |threads, count: usize, f: &(dyn Fn(usize) + Sync)| {
             let secs = timed(threads, || {
-                rays.par_iter().for_each(|(o, d)| {
-                    std::hint::black_box(ctx.vis.closest_hit(*o, *d));
-                })
+                (0..count).into_par_iter().for_each(f);
             });
-            rays.len() as f64 / secs / 1e6
+            count as f64 / secs / 1e6
         };
-        let occlusion = |threads| {
-            let secs = timed(threads, || {
-                rays.par_iter().zip(&hits).for_each(|((o, d), h)| {
-                    let end = *o + *d * h.map_or(1e3, |t| t as f64);
-                    std::hint::black_box(ctx.vis.occluded(*o, end));
-                })
-            });
-            rays.len() as f64 / secs / 1e6
+        let closest = |i: usize| {
+            std::hint::black_box(ctx.vis.trace_closest(&rays32[i]));
         };
-        let (c1, c2, o1, o2) = (closest(1), closest(2), occlusion(1), occlusion(2));
-        let pair = |threads| {
-            let secs = timed(threads, || {
-                segments.par_iter().for_each(|(a, b)| {
-                    std::hint::black_box(ctx.vis.occluded(*a, *b));
-                })
-            });
-            segments.len() as f64 / secs / 1e6
+        let occlusion = |i: usize| {
+            std::hint::black_box(ctx.vis.trace_occluded(&cut32[i]));
         };
-        let (p1, p2) = (pair(1), pair(2));
-        let occluded = segments
+        let pair = |i: usize| {
+            std::hint::black_box(ctx.vis.trace_occluded(&segs32[i]));
+        };
+        let (c1, c2) = (rate(1, rays.len(), &closest), rate(2, rays.len(), &closest));
+        let (o1, o2) = (
+            rate(1, rays.len(), &occlusion),
+            rate(2, rays.len(), &occlusion),
+        );
+        let (p1, p2) = (
+            rate(1, segments.len(), &pair),
+            rate(2, segments.len(), &pair),
+        );
+        let occluded = segs32
             .par_iter()
-            .filter(|(a, b)| ctx.vis.occluded(*a, *b))
+            .filter(|r| ctx.vis.trace_occluded(r))
             .count();
+        // The stage's entry points on the same rays: f64 origins and endpoints, one thread.
+        let stage_closest = |i: usize| {
+            std::hint::black_box(ctx.vis.closest_hit(rays[i].0, rays[i].1));
+        };
+        let stage_occlusion = |i: usize| {
+            let (o, d) = rays[i];
+            let end = o + d * hits[i].map_or(1e3, |t| t as f64);
+            std::hint::black_box(ctx.vis.occluded(o, end));
+        };
+        let stage_pair = |i: usize| {
+            std::hint::black_box(ctx.vis.occluded(segments[i].0, segments[i].1));
+        };
+        stage.push(format!(
+            "| {name} | {:.2} | {:.2} | {:.2} |",
+            rate(1, rays.len(), &stage_closest),
+            rate(1, rays.len(), &stage_occlusion),
+            rate(1, segments.len(), &stage_pair)
+        ));
         let out = std::process::Command::new("python3")
             .args(["-c", EMBREE, dir.to_str().unwrap()])
             .output();
@@ -172,6 +210,12 @@ fn main() {
     println!("| scene | segments | occluded relume (Embree) | relume 1 / 2 threads | Embree 1 thread | relume / Embree per core |");
     println!("|---|---|---|---|---|---|");
     for p in &pairs {
+        println!("{p}");
+    }
+    println!("\nThe stage's entry points on the same rays (f64 origins and endpoints: `closest_hit`, `occluded`), one thread; Mrays/s\n");
+    println!("| scene | closest | occlusion (cut rays) | pairwise segments |");
+    println!("|---|---|---|---|");
+    for p in &stage {
         println!("{p}");
     }
     let _ = std::fs::remove_dir_all(&tmp);

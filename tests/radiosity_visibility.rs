@@ -8,7 +8,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 use relume::radiosity::fixtures::random_soup;
 use relume::radiosity::geometry::Frame;
-use relume::radiosity::visibility::Visibility;
+use relume::radiosity::visibility::{Ray, Visibility};
 use relume::scene::builder::SceneBuilder;
 use relume::scene::Scene;
 
@@ -75,6 +75,31 @@ fn check(vis: &Visibility, origin: DVec3, dir: DVec3) -> Result<(), TestCaseErro
         prop_assert_eq!(
             vis.occluded(origin, to),
             vis.occluded_brute_force(origin, to)
+        );
+    }
+    // The same ray as an f32 tracer (Embree, benches/visibility_embree.rs) takes it: origin,
+    // direction and length in f32.
+    let (o, d) = (origin.as_vec3().to_array(), dir.as_vec3().to_array());
+    let ray = Ray::from_f32(o, d, f32::INFINITY);
+    let (fast, slow) = (vis.trace_closest(&ray), vis.trace_closest_brute_force(&ray));
+    prop_assert_eq!(
+        fast.map(|h| (h.triangle, h.t.to_bits())),
+        slow.map(|h| (h.triangle, h.t.to_bits()))
+    );
+    for len in [0.05f32, 0.3, 2.0] {
+        let seg = Ray::from_f32(o, d, len);
+        prop_assert_eq!(
+            vis.trace_occluded(&seg),
+            vis.trace_occluded_brute_force(&seg)
+        );
+    }
+    // Occlusion up to a closest hit's reported distance includes that hit (the bench's cut
+    // rays rely on it, as Embree's occlusion up to its own tfar does).
+    if let Some(h) = fast {
+        prop_assert!(
+            vis.trace_occluded(&Ray::from_f32(o, d, h.t)),
+            "hit at {} not occluding",
+            h.t
         );
     }
     Ok(())

@@ -153,18 +153,24 @@ impl Visibility {
 
     /// The closest hit along `dir` (unit) from `origin`. Callers start rays slightly off the
     /// surface (lifted by [`Visibility::epsilon`] along its normal), so every hit with t ≥ 0 counts.
+    #[inline]
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let (start, d) = ray_start(origin, dir);
-        let wt = Watertight::new(start, d);
-        let ray = BoxRay::new(start.to_array(), d.to_array());
+        self.trace_closest(&Ray::new(origin, dir))
+    }
+
+    /// The closest hit of `ray` (any `tmax` it carries is ignored).
+    #[inline]
+    pub fn trace_closest(&self, ray: &Ray) -> Option<Hit> {
+        let wt = Watertight::new(ray.start, ray.dir);
+        let boxes = BoxRay::new(ray.start.to_array(), ray.dir.to_array());
         let mut leaf = Closest {
             vis: self,
             wt: &wt,
-            d,
+            d: ray.dir,
             best: u32::MAX,
         };
-        let t = self.bvh.closest(&ray, BACKOFF, f32::INFINITY, &mut leaf);
-        self.hit(leaf.best, t, d)
+        let t = self.bvh.closest(&boxes, BACKOFF, f32::INFINITY, &mut leaf);
+        self.hit(leaf.best, t, ray.dir)
     }
 
     /// The hit on slot `s` (none for `u32::MAX`) at `t` from the backed-off start.
@@ -193,7 +199,12 @@ impl Visibility {
     /// [`Visibility::closest_hit`] by testing every triangle slot in order with the scalar test:
     /// the same answer bit for bit (tests/radiosity_visibility.rs), without the tree.
     pub fn closest_hit_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
-        let (start, d) = ray_start(origin, dir);
+        self.trace_closest_brute_force(&Ray::new(origin, dir))
+    }
+
+    /// [`Visibility::trace_closest`] by testing every triangle slot in order with the scalar test.
+    pub fn trace_closest_brute_force(&self, ray: &Ray) -> Option<Hit> {
+        let (start, d) = (ray.start, ray.dir);
         let wt = Watertight::new(start, d);
         let (mut best, mut tmax) = (u32::MAX, f32::INFINITY);
         for (s, tri) in self.all_slots() {
@@ -207,12 +218,14 @@ impl Visibility {
 
     /// [`Visibility::occluded`] by testing every triangle slot with the scalar test.
     pub fn occluded_brute_force(&self, from: DVec3, to: DVec3) -> bool {
-        let Some((start, d, tmax)) = segment(from, to) else {
-            return false;
-        };
-        let wt = Watertight::new(start, d);
+        Ray::segment(from, to).is_some_and(|ray| self.trace_occluded_brute_force(&ray))
+    }
+
+    /// [`Visibility::trace_occluded`] by testing every triangle slot with the scalar test.
+    pub fn trace_occluded_brute_force(&self, ray: &Ray) -> bool {
+        let wt = Watertight::new(ray.start, ray.dir);
         self.all_slots()
-            .any(|(s, tri)| self.counts(s, wt.intersect(&tri, BACKOFF, tmax), d))
+            .any(|(s, tri)| self.counts(s, wt.intersect(&tri, BACKOFF, ray.tmax), ray.dir))
     }
 
     /// Whether a distance `t` of the watertight test (from the start `BACKOFF` behind the
@@ -230,19 +243,23 @@ impl Visibility {
 
     /// True when a surface lies on the segment from `from` to `to` (both lifted off their
     /// surfaces by the caller).
+    #[inline]
     pub fn occluded(&self, from: DVec3, to: DVec3) -> bool {
-        let Some((start, d, tmax)) = segment(from, to) else {
-            return false;
-        };
-        let wt = Watertight::new(start, d);
-        let ray = BoxRay::new(start.to_array(), d.to_array());
+        Ray::segment(from, to).is_some_and(|ray| self.trace_occluded(&ray))
+    }
+
+    /// True when a surface lies on `ray` up to its `tmax`.
+    #[inline]
+    pub fn trace_occluded(&self, ray: &Ray) -> bool {
+        let wt = Watertight::new(ray.start, ray.dir);
+        let boxes = BoxRay::new(ray.start.to_array(), ray.dir.to_array());
         let mut leaf = Occluding {
             vis: self,
             wt: &wt,
-            d,
-            tmax,
+            d: ray.dir,
+            tmax: ray.tmax,
         };
-        self.bvh.any(&ray, BACKOFF, tmax, &mut leaf)
+        self.bvh.any(&boxes, BACKOFF, ray.tmax, &mut leaf)
     }
 }
 
@@ -301,24 +318,62 @@ struct SlotInfo {
     triangle: u32,
 }
 
-/// A ray's start `BACKOFF` behind `origin` and its direction, in f32.
-fn ray_start(origin: DVec3, dir: DVec3) -> (Vec3A, Vec3A) {
-    (
-        Vec3A::from((origin - dir * BACKOFF as f64).as_vec3()),
-        Vec3A::from(dir.as_vec3()),
-    )
+/// A ray as the tracer takes it, in f32 grid coordinates: its start `BACKOFF` behind the
+/// caller's origin, its unit direction, and the far end of the segment (from the start) for an
+/// occlusion query.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub start: Vec3A,
+    pub dir: Vec3A,
+    pub tmax: f32,
 }
 
-/// The ray of the segment `from → to`: its start, direction and `tmax` (from the start), or none
-/// for an empty segment.
-fn segment(from: DVec3, to: DVec3) -> Option<(Vec3A, Vec3A, f32)> {
-    let delta = to - from;
-    let len = delta.length();
-    if len <= 0.0 {
-        return None;
+impl Ray {
+    /// The ray from `origin` along `dir` (unit), unbounded: the start is backed off in f64 and
+    /// rounded once.
+    #[inline]
+    pub fn new(origin: DVec3, dir: DVec3) -> Ray {
+        Ray {
+            start: Vec3A::from((origin - dir * BACKOFF as f64).as_vec3()),
+            dir: Vec3A::from(dir.as_vec3()),
+            tmax: f32::INFINITY,
+        }
     }
-    let (start, d) = ray_start(from, delta * (1.0 / len));
-    Some((start, d, len as f32 + BACKOFF))
+
+    /// The segment `from → to` (length and direction in f64), or none for an empty segment.
+    #[inline]
+    pub fn segment(from: DVec3, to: DVec3) -> Option<Ray> {
+        let delta = to - from;
+        let len = delta.length();
+        if len <= 0.0 {
+            return None;
+        }
+        Some(Ray {
+            tmax: len as f32 + BACKOFF,
+            ..Ray::new(from, delta * (1.0 / len))
+        })
+    }
+
+    /// The ray an f32 tracer such as Embree takes: `origin`, unit `dir`, and the segment's
+    /// length `len` (infinity for a closest-hit ray), all in f32. The far end is inclusive with
+    /// one ulp to spare, so that a closest hit's reported distance is always within it (as an
+    /// Embree occlusion query up to a hit's `tfar` is).
+    #[inline]
+    pub fn from_f32(origin: [f32; 3], dir: [f32; 3], len: f32) -> Ray {
+        let (origin, dir) = (Vec3A::from(origin), Vec3A::from(dir));
+        // len + BACKOFF > 0: the next float up is one more in its bits (f32::next_up needs Rust
+        // 1.86, above this crate's minimum).
+        let end = len + BACKOFF;
+        Ray {
+            start: origin - dir * BACKOFF,
+            dir,
+            tmax: if end.is_finite() {
+                f32::from_bits(end.to_bits() + 1)
+            } else {
+                end
+            },
+        }
+    }
 }
 
 /// The ray epsilon for a grid whose largest coordinate is `extent`: a few hundred f32 ulps of the

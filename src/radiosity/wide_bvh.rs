@@ -250,7 +250,7 @@ impl WideBvh {
                 tmax = leaf.leaf((current & !LEAF) >> 3, current & 7, tmax);
             } else {
                 let node = &self.nodes[current as usize];
-                let mut mask = hits(node, ray, tmin, tmax + self.margin, &mut dist);
+                let mut mask = hits(node, ray, tmin, tmax + self.margin, &mut dist) & 0xff;
                 if mask != 0 {
                     let k = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -293,27 +293,48 @@ impl WideBvh {
         leaf: &mut impl AnyLeaf,
         hits: impl Fn(&Node, &BoxRay, f32, f32, &mut [f32; 8]) -> u32,
     ) -> bool {
-        let mut stack = Stack::<u32>::new();
+        // Leaves are tested at the node that holds them, so the stack only ever holds nodes;
+        // the first hit node is visited next without going through the stack.
+        let mut items = [const { std::mem::MaybeUninit::<u32>::uninit() }; STACK];
+        let mut sp = 0usize;
         let mut current = self.root;
+        if current & LEAF != 0 {
+            return leaf.leaf((current & !LEAF) >> 3, current & 7);
+        }
         let mut dist = [0.0f32; 8];
         loop {
-            if current & LEAF != 0 {
-                if leaf.leaf((current & !LEAF) >> 3, current & 7) {
+            let node = &self.nodes[current as usize];
+            let both = hits(node, ray, tmin, tmax + self.margin, &mut dist);
+            let mut leaves = both & (both >> 8);
+            let mut inner = both & !(both >> 8) & 0xff;
+            while leaves != 0 {
+                let k = leaves.trailing_zeros() as usize;
+                leaves &= leaves - 1;
+                let c = node.child[k];
+                if leaf.leaf((c & !LEAF) >> 3, c & 7) {
                     return true;
                 }
-            } else {
-                let node = &self.nodes[current as usize];
-                let mut mask = hits(node, ray, tmin, tmax + self.margin, &mut dist);
-                while mask != 0 {
-                    let k = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack.push(node.child[k]);
+            }
+            if inner != 0 {
+                let k = inner.trailing_zeros() as usize;
+                inner &= inner - 1;
+                current = node.child[k];
+                assert!(sp + 8 <= STACK, "BVH traversal stack overflow");
+                while inner != 0 {
+                    let k = inner.trailing_zeros() as usize;
+                    inner &= inner - 1;
+                    // SAFETY: sp + 7 < STACK, checked above.
+                    unsafe { items.get_unchecked_mut(sp).write(node.child[k]) };
+                    sp += 1;
                 }
+                continue;
             }
-            match stack.pop() {
-                Some(c) => current = c,
-                None => return false,
+            if sp == 0 {
+                return false;
             }
+            sp -= 1;
+            // SAFETY: slots below sp were written above.
+            current = unsafe { items.get_unchecked(sp).assume_init() };
         }
     }
 }
@@ -441,6 +462,9 @@ fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mu
         if near <= far {
             mask |= 1 << k;
         }
+        if node.child[k] & LEAF != 0 {
+            mask |= 1 << (8 + k);
+        }
     }
     mask
 }
@@ -486,7 +510,8 @@ unsafe fn node_hits_avx2(
         _mm256_set1_ps(tmax),
     );
     _mm256_storeu_ps(dist.as_mut_ptr(), near);
-    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+    let leaves = _mm256_movemask_ps(_mm256_load_ps(node.child.as_ptr() as *const f32)) as u32;
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32 | leaves << 8
 }
 
 #[cfg(test)]
@@ -528,7 +553,7 @@ mod tests {
             let n = node(&boxes);
             let ray = BoxRay::new(o, d);
             let mut a = [0.0; 8];
-            let ma = node_hits_portable(&n, &ray, 1e-4, tmax, &mut a);
+            let ma = node_hits_portable(&n, &ray, 1e-4, tmax, &mut a) & 0xff;
             // Exact reference: the ray meets the box where every axis allows it.
             for (k, (lo, hi)) in boxes.iter().enumerate() {
                 let (mut near, mut far) = (1e-4f64, tmax as f64);
@@ -553,7 +578,7 @@ mod tests {
             if crate::cpu::has_avx2_fma() {
                 let mut b = [0.0; 8];
                 // SAFETY: AVX2 and FMA detected.
-                let mb = unsafe { node_hits_avx2(&n, &ray, 1e-4, tmax, &mut b) };
+                let mb = unsafe { node_hits_avx2(&n, &ray, 1e-4, tmax, &mut b) } & 0xff;
                 prop_assert_eq!(ma, mb);
                 for k in 0..8 {
                     if ma & (1 << k) != 0 {

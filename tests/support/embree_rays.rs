@@ -60,14 +60,9 @@ pub fn write_for_embree(
     let triangles = write_triangles(dir, ctx);
     // Embree gets each ray from its origin in f32 (relume rounds its backed-off start to f32
     // separately: see tests/visibility_embree.rs for what that allows).
-    let o: Vec<f32> = rays
-        .iter()
-        .flat_map(|(o, _)| o.as_vec3().to_array())
-        .collect();
-    let d: Vec<f32> = rays
-        .iter()
-        .flat_map(|(_, d)| d.as_vec3().to_array())
-        .collect();
+    let f32_rays = f32_rays(rays);
+    let o: Vec<f32> = f32_rays.iter().flat_map(|r| r.0).collect();
+    let d: Vec<f32> = f32_rays.iter().flat_map(|r| r.1).collect();
     let n = rays.len() as u64;
     write_f32(dir, "origins.npy", &[n, 3], &o);
     write_f32(dir, "dirs.npy", &[n, 3], &d);
@@ -105,14 +100,36 @@ pub fn write_segments(dir: &Path, segments: &[(DVec3, DVec3)]) {
     let mut o = Vec::new();
     let mut d = Vec::new();
     let mut l = Vec::new();
-    for (from, to) in segments {
-        let delta = *to - *from;
-        o.extend(from.as_vec3().to_array());
-        d.extend(delta.normalize().as_vec3().to_array());
-        l.push(delta.length() as f32);
+    for (from, dir, len) in f32_segments(segments) {
+        o.extend(from);
+        d.extend(dir);
+        l.push(len);
     }
     let n = segments.len() as u64;
     write_f32(dir, "seg_origins.npy", &[n, 3], &o);
     write_f32(dir, "seg_dirs.npy", &[n, 3], &d);
     write_f32(dir, "seg_lengths.npy", &[n], &l);
+}
+
+/// The rays as f32 (origin, unit direction): exactly what [`write_for_embree`] writes.
+pub fn f32_rays(rays: &[(DVec3, DVec3)]) -> Vec<([f32; 3], [f32; 3])> {
+    rays.iter()
+        .map(|(o, d)| (o.as_vec3().to_array(), d.as_vec3().to_array()))
+        .collect()
+}
+
+/// The segments as f32 (origin, unit direction, length): exactly what [`write_segments`]
+/// writes.
+pub fn f32_segments(segments: &[(DVec3, DVec3)]) -> Vec<([f32; 3], [f32; 3], f32)> {
+    segments
+        .iter()
+        .map(|(from, to)| {
+            let delta = *to - *from;
+            (
+                from.as_vec3().to_array(),
+                delta.normalize().as_vec3().to_array(),
+                delta.length() as f32,
+            )
+        })
+        .collect()
 }
