@@ -43,33 +43,43 @@ scene.run(o[:1000], v[:1000], output=1)  # warm-up
 # Timed with output=0 (primitive ids only): output=1 also copies t, u, v and the normal out
 # into numpy arrays, which measured 1.05-1.23x slower and is Python's cost, not Embree's.
 best = 1e30
-for _ in range(3):
+for _ in range(5):
     t = time.perf_counter(); scene.run(o, v, output=0); best = min(best, time.perf_counter() - t)
 r = scene.run(o, v, output=1)
 tfar = np.where(r['primID'] >= 0, r['tfar'], 1e30).astype(np.float32)
 occ = 1e30
-for _ in range(3):
+for _ in range(5):
     t = time.perf_counter(); scene.run(o, v, dists=np.minimum(tfar, 1e30), query='OCCLUDED'); occ = min(occ, time.perf_counter() - t)
 so = np.load(d + '/seg_origins.npy'); sv = np.load(d + '/seg_dirs.npy'); sl = np.load(d + '/seg_lengths.npy')
 seg = 1e30
-for _ in range(3):
+for _ in range(5):
     t = time.perf_counter(); so_r = scene.run(so, sv, dists=sl, query='OCCLUDED'); seg = min(seg, time.perf_counter() - t)
 print(len(o) / best / 1e6, len(o) / occ / 1e6, int((r['primID'] >= 0).sum()), len(so) / seg / 1e6, int((np.asarray(so_r) != -1).sum()))
 "#;
 
-/// Best of three wall times of `f` in a pool of `threads`.
-fn timed(threads: usize, f: impl Fn() + Sync + Send) -> f64 {
+/// Mrays/s of `f` over rays `0..count`, best of five: one thread runs a plain loop (as
+/// Embree's one thread does), more split the rays into chunks of 1,024 over a pool.
+fn rate(threads: usize, count: usize, f: impl Fn(usize) + Sync + Send) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
-    (0..3)
+    let secs = (0..5)
         .map(|_| {
             let t = Instant::now();
-            pool.install(&f);
+            if threads == 1 {
+                (0..count).for_each(&f);
+            } else {
+                pool.install(|| {
+                    (0..count.div_ceil(1024)).into_par_iter().for_each(|c| {
+                        (c * 1024..(c * 1024 + 1024).min(count)).for_each(&f);
+                    })
+                });
+            }
             t.elapsed().as_secs_f64()
         })
-        .fold(f64::INFINITY, f64::min)
+        .fold(f64::INFINITY, f64::min);
+    count as f64 / secs / 1e6
 }
 
 fn main() {
@@ -98,7 +108,7 @@ fn main() {
             4000,
         ),
     ];
-    println!("Hemisphere rays of the form-factor stage, 64 per patch; best of 3; Mrays/s\n");
+    println!("Hemisphere rays of the form-factor stage, 64 per patch; best of 5; Mrays/s\n");
     println!("| scene | triangles | rays | hits | relume closest 1 / 2 threads | Embree closest 1 thread | relume occlusion 1 / 2 threads | Embree occlusion 1 thread | relume / Embree per core (closest, occlusion) |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut pairs = Vec::new();
@@ -131,12 +141,6 @@ fn main() {
             .into_iter()
             .map(|(o, d, l)| Ray::from_f32(o, d, l))
             .collect();
-        let rate = |threads, count: usize, f: &(dyn Fn(usize) + Sync)| {
-            let secs = timed(threads, || {
-                (0..count).into_par_iter().for_each(f);
-            });
-            count as f64 / secs / 1e6
-        };
         let closest = |i: usize| {
             std::hint::black_box(ctx.vis.trace_closest(&rays32[i]));
         };
@@ -146,14 +150,14 @@ fn main() {
         let pair = |i: usize| {
             std::hint::black_box(ctx.vis.trace_occluded(&segs32[i]));
         };
-        let (c1, c2) = (rate(1, rays.len(), &closest), rate(2, rays.len(), &closest));
+        let (c1, c2) = (rate(1, rays.len(), closest), rate(2, rays.len(), closest));
         let (o1, o2) = (
-            rate(1, rays.len(), &occlusion),
-            rate(2, rays.len(), &occlusion),
+            rate(1, rays.len(), occlusion),
+            rate(2, rays.len(), occlusion),
         );
         let (p1, p2) = (
-            rate(1, segments.len(), &pair),
-            rate(2, segments.len(), &pair),
+            rate(1, segments.len(), pair),
+            rate(2, segments.len(), pair),
         );
         let occluded = segs32
             .par_iter()
@@ -173,9 +177,9 @@ fn main() {
         };
         stage.push(format!(
             "| {name} | {:.2} | {:.2} | {:.2} |",
-            rate(1, rays.len(), &stage_closest),
-            rate(1, rays.len(), &stage_occlusion),
-            rate(1, segments.len(), &stage_pair)
+            rate(1, rays.len(), stage_closest),
+            rate(1, rays.len(), stage_occlusion),
+            rate(1, segments.len(), stage_pair)
         ));
         let out = std::process::Command::new("python3")
             .args(["-c", EMBREE, dir.to_str().unwrap()])
