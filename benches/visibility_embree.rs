@@ -155,10 +155,7 @@ fn main() {
             rate(1, rays.len(), occlusion),
             rate(2, rays.len(), occlusion),
         );
-        let (p1, p2) = (
-            rate(1, segments.len(), pair),
-            rate(2, segments.len(), pair),
-        );
+        let (p1, p2) = (rate(1, segments.len(), pair), rate(2, segments.len(), pair));
         let occluded = segs32
             .par_iter()
             .filter(|r| ctx.vis.trace_occluded(r))

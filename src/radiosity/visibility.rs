@@ -278,7 +278,15 @@ impl AnyLeaf for Occluding<'_> {
             self.vis
                 .blocks
                 .intersect4(self.wt, leaf as usize, count as usize, BACKOFF, self.tmax);
-        (0..count as usize).any(|k| self.vis.counts(4 * leaf + k as u32, ts[k], self.d))
+        // Lanes past `count` are infinite. Without branches per lane: a hit beyond the
+        // epsilon stops the ray ([`Visibility::counts`]); only a nearer one needs its normal.
+        if ts.iter().fold(false, |a, &t| {
+            a | (t != f32::INFINITY && t - BACKOFF >= self.vis.epsilon)
+        }) {
+            return true;
+        }
+        ts.iter().fold(false, |a, &t| a | (t != f32::INFINITY))
+            && (0..count as usize).any(|k| self.vis.counts(4 * leaf + k as u32, ts[k], self.d))
     }
 }
 

@@ -120,7 +120,7 @@ impl TriangleBlocks {
     }
 
     /// The distances of [`Watertight::intersect`] to the first `count` triangles of block
-    /// `block` (lanes `count..` hold unused values).
+    /// `block` (lanes `count..` hold infinity).
     #[inline(always)]
     pub fn intersect4(
         &self,
@@ -207,7 +207,16 @@ impl TriangleBlocks {
             _mm_cmpge_ps(t, _mm_set1_ps(tmin)),
             _mm_cmple_ps(t, _mm_set1_ps(tmax)),
         );
-        let hit = _mm_andnot_ps(miss, inside);
+        // Lanes past `count` (unused, repeating the first triangle) always miss.
+        const LANES: [[u32; 4]; 5] = [
+            [0, 0, 0, 0],
+            [!0, 0, 0, 0],
+            [!0, !0, 0, 0],
+            [!0, !0, !0, 0],
+            [!0; 4],
+        ];
+        let used = _mm_castsi128_ps(_mm_loadu_si128(LANES[count].as_ptr() as *const __m128i));
+        let hit = _mm_and_ps(_mm_andnot_ps(miss, inside), used);
         let mut out = [0.0f32; 4];
         _mm_storeu_ps(
             out.as_mut_ptr(),
