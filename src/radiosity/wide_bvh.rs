@@ -433,7 +433,8 @@ fn union(a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])) -> ([f32; 3], [f32; 3
 }
 
 /// The slab test of the eight children, one lane at a time: bit k of the result is set when the
-/// ray meets child k's box within `[tmin, tmax]`, and `dist[k]` is then its entry distance.
+/// ray meets child k's box within `[tmin, tmax]`, and `dist[k]` is then its entry distance; bit
+/// 8 + k when child k is a leaf (or an empty slot, which no ray enters).
 #[inline(always)]
 fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mut [f32; 8]) -> u32 {
     let mut mask = 0;
@@ -459,7 +460,7 @@ fn node_hits_portable(node: &Node, ray: &BoxRay, tmin: f32, tmax: f32, dist: &mu
 }
 
 /// [`node_hits_portable`] for all eight lanes at once (AVX2 + FMA). Same operations, same order
-/// per lane, so the same mask and distances: `mul_add` is the fused operation, `max`/`min` of
+/// per lane, so the same masks and distances (the leaf bits are the references' sign bits): `mul_add` is the fused operation, `max`/`min` of
 /// two floats are exact (no NaN arises: see [`BoxRay`]), and the running near bound never holds
 /// −0 (it starts at `tmin` > 0).
 #[cfg(target_arch = "x86_64")]
@@ -526,8 +527,9 @@ mod tests {
     }
 
     proptest! {
-        /// The AVX2 node test is the portable one's twin: the same hit mask and the same entry
-        /// distances bit for bit, with empty slots, flat boxes and zero direction components.
+        /// The AVX2 node test is the portable one's twin: the same hit and leaf masks and the
+        /// same entry distances bit for bit, with empty slots, flat boxes and zero direction
+        /// components.
         #[test]
         fn avx2_node_test_equals_the_portable_one(
             boxes in prop::collection::vec((prop::array::uniform3(coordinate()), prop::array::uniform3(0u8..3)), 0..=8),
@@ -542,7 +544,10 @@ mod tests {
             let n = node(&boxes);
             let ray = BoxRay::new(o, d);
             let mut a = [0.0; 8];
-            let ma = node_hits_portable(&n, &ray, 1e-4, tmax, &mut a) & 0xff;
+            let full = node_hits_portable(&n, &ray, 1e-4, tmax, &mut a);
+            let ma = full & 0xff;
+            // The test's children are node references; only the empty slots have the leaf bit.
+            prop_assert_eq!(full >> 8, (0xff << boxes.len()) & 0xff);
             // Exact reference: the ray meets the box where every axis allows it.
             for (k, (lo, hi)) in boxes.iter().enumerate() {
                 let (mut near, mut far) = (1e-4f64, tmax as f64);
@@ -567,8 +572,8 @@ mod tests {
             if crate::cpu::has_avx2_fma() {
                 let mut b = [0.0; 8];
                 // SAFETY: AVX2 and FMA detected.
-                let mb = unsafe { node_hits_avx2(&n, &ray, 1e-4, tmax, &mut b) } & 0xff;
-                prop_assert_eq!(ma, mb);
+                let mb = unsafe { node_hits_avx2(&n, &ray, 1e-4, tmax, &mut b) };
+                prop_assert_eq!(full, mb);
                 for k in 0..8 {
                     if ma & (1 << k) != 0 {
                         prop_assert_eq!(a[k].to_bits(), b[k].to_bits());
