@@ -123,19 +123,20 @@ fn main() {
         let n = rays.len() as u64;
         // The f32 rays as Embree gets them; occlusion up to relume's own closest hit (Embree's
         // occlusion goes up to its own).
-        let rays32: Vec<Ray> = f32_rays(&rays)
-            .into_iter()
-            .map(|(o, d)| Ray::from_f32(o, d, f32::INFINITY))
+        let f32_rays = f32_rays(&rays);
+        let rays32: Vec<Ray> = f32_rays
+            .iter()
+            .map(|&(o, d)| Ray::from_f32(o, d, f32::INFINITY))
             .collect();
         let hits: Vec<Option<f32>> = rays32
             .par_iter()
             .map(|r| ctx.vis.trace_closest(r).map(|h| h.t))
             .collect();
         let hit_count = hits.iter().flatten().count();
-        let cut32: Vec<Ray> = f32_rays(&rays)
-            .into_iter()
+        let cut32: Vec<Ray> = f32_rays
+            .iter()
             .zip(&hits)
-            .map(|((o, d), h)| Ray::from_f32(o, d, h.unwrap_or(1e3)))
+            .map(|(&(o, d), h)| Ray::from_f32(o, d, h.unwrap_or(1e3)))
             .collect();
         let segs32: Vec<Ray> = f32_segments(&segments)
             .into_iter()

@@ -208,14 +208,10 @@ impl TriangleBlocks {
             _mm_cmple_ps(t, _mm_set1_ps(tmax)),
         );
         // Lanes past `count` (unused, repeating the first triangle) always miss.
-        const LANES: [[u32; 4]; 5] = [
-            [0, 0, 0, 0],
-            [!0, 0, 0, 0],
-            [!0, !0, 0, 0],
-            [!0, !0, !0, 0],
-            [!0; 4],
-        ];
-        let used = _mm_castsi128_ps(_mm_loadu_si128(LANES[count].as_ptr() as *const __m128i));
+        let used = _mm_castsi128_ps(_mm_cmplt_epi32(
+            _mm_setr_epi32(0, 1, 2, 3),
+            _mm_set1_epi32(count as i32),
+        ));
         let hit = _mm_and_ps(_mm_andnot_ps(miss, inside), used);
         let mut out = [0.0f32; 4];
         _mm_storeu_ps(
