@@ -10,10 +10,17 @@
 //!    (a, b) on (at least one period away), popping the vertices before the tangent point: they
 //!    lie under the chord from P (pushed in step 4) to the tangent point, so no pixel further
 //!    back can need them (Timonen & Westerholm's amortised O(1) query).
-//! 3. *Period pushes*, in decreasing τ, of the samples above the chord from P to P′ only: a
-//!    sample under that chord is under the hull of {P, P′} and can be the tangent point of no
-//!    pixel behind P (for P itself, step 1 has it). This skips the push of most samples on
-//!    terrain that curves up between P and P′.
+//! 3. *Period pushes*, in decreasing τ, of the samples from the period's tangent point on, and
+//!    only where it beats the far tangent. After P is pushed (step 4), the hull's vertex after
+//!    P is the point of largest slope from P over everything to its right (ties: the farthest);
+//!    every sample between P and that point lies under the chord to it and can be the tangent
+//!    point of no pixel behind P. So a lane whose far slope is at least the period's largest
+//!    pushes nothing from the period, nor pops again in step 4 (step 2's query made the same
+//!    test), and one whose period wins pushes from its last sample of largest slope, m, on.
+//!    Of those, a sample under the chord from P to P′, or under the segment between its
+//!    neighbours, is skipped too (it lies under the hull of those points). On Puget Sound
+//!    (1024², 64 directions) the period wins in 37 % of the lane steps, and the lane pushes
+//!    fall from 2.18 to 1.39 per step against the chord and neighbour tests alone.
 //! 4. *P itself* (the full transit of its texel is its centre: a chord through a square's
 //!    centre is halved there), for the pixels behind it.
 //!
@@ -77,7 +84,7 @@ pub(super) struct HullsF32 {
     top_y: [[f32; LANES]; 3],
     top_x: [[i32; LANES]; 3],
     // Portable layout: a stack per lane.
-    stacks: [Vec<(i32, f32)>; LANES],
+    stacks: [LaneStack; LANES],
     /// f_P′ of the previous step, and where its pixel was on the map.
     f_prev: [f32; LANES],
     prev_on: [i32; LANES],
@@ -93,7 +100,10 @@ impl HullsF32 {
             top: [[0; LANES]; 3],
             top_y: [[0.0; LANES]; 3],
             top_x: [[0; LANES]; 3],
-            stacks: std::array::from_fn(|_| Vec::new()),
+            stacks: std::array::from_fn(|_| LaneStack {
+                buf: Vec::new(),
+                len: 0,
+            }),
             f_prev: [0.0; LANES],
             prev_on: [0; LANES],
         }
@@ -113,7 +123,12 @@ impl HullsF32 {
         self.top = [[0; LANES]; 3];
         self.top_y = [[0.0; LANES]; 3];
         self.top_x = [[0; LANES]; 3];
-        self.stacks.iter_mut().for_each(Vec::clear);
+        for f in &mut self.stacks {
+            if f.buf.len() < pushes + 2 {
+                f.buf.resize(pushes + 2, (0, 0.0));
+            }
+            f.len = 0;
+        }
         self.prev_on = [0; LANES];
     }
 
@@ -143,63 +158,90 @@ impl HullsF32 {
         out
     }
 
+    /// Lane j's step (module notes, steps 1–4): the portable kernel.
+    #[inline(always)]
     fn step_lane(&mut self, s: &Step, l: &LaneInput, j: usize) -> f32 {
         let (zp, count) = (l.zp[j], l.count[j] as usize);
         let mut near = (l.own[j] - s.own_drop) * s.own_inv;
+        let (mut best, mut m) = (f32::NEG_INFINITY, 0usize);
         for i in 0..count {
-            near = near.max((l.heights[i][j] - s.near_drop[i]) * s.near_inv[i]);
+            let v = (l.heights[i][j] - s.near_drop[i]) * s.near_inv[i];
+            m = if v >= best { i } else { m };
+            best = best.max(v);
         }
+        near = near.max(best);
         let fp = zp - s.drop_p;
-        let stack = &mut self.stacks[j];
-        pop_while(stack, (s.xp, fp));
-        let far = match stack.last() {
-            Some(&(x1, y1)) => (y1 - fp) / (x1 - s.xp) as f32 * s.scale + s.shift,
-            None => f32::NEG_INFINITY,
+        let st = &mut self.stacks[j];
+        st.pop_while(s.xp, fp);
+        let far = if st.len > 0 {
+            let (x1, y1) = st.top();
+            (y1 - fp) / (x1 - s.xp) as f32 * s.scale + s.shift
+        } else {
+            f32::NEG_INFINITY
         };
-        let (prev_on, f_next) = (self.prev_on[j] != 0, self.f_prev[j]);
-        let y = |i: usize| l.heights[i][j] + (zp - s.drop[i]);
-        let dx = |i: usize| (s.xs[i] - s.xp) as f32;
-        for i in (0..count).rev() {
-            let yi = y(i);
-            // Under the chord from P to P′, or under the segment between its neighbours.
-            if prev_on && (yi - fp) * s.dx_next <= (f_next - fp) * dx(i) {
-                continue;
-            }
-            let (xl, yl) = if i == 0 {
-                (0.0, fp)
-            } else {
-                (dx(i - 1), y(i - 1))
-            };
-            let right = if i + 1 < count {
-                Some((dx(i + 1), y(i + 1)))
-            } else {
-                (prev_on && i + 1 == s.xs.len()).then_some((s.dx_next, f_next))
-            };
-            if let Some((xr, yr)) = right {
-                if (yi - yl) * (xr - xl) <= (yr - yl) * (dx(i) - xl) {
+        if best > far {
+            let (prev_on, f_next) = (self.prev_on[j] != 0, self.f_prev[j]);
+            let y = |i: usize| l.heights[i][j] + (zp - s.drop[i]);
+            let dx = |i: usize| (s.xs[i] - s.xp) as f32;
+            for i in (m..count).rev() {
+                let yi = y(i);
+                if prev_on && (yi - fp) * s.dx_next <= (f_next - fp) * dx(i) {
                     continue;
                 }
+                let (xl, yl) = if i == 0 {
+                    (0.0, fp)
+                } else {
+                    (dx(i - 1), y(i - 1))
+                };
+                let right = if i + 1 < count {
+                    Some((dx(i + 1), y(i + 1)))
+                } else {
+                    (prev_on && i + 1 == s.xs.len()).then_some((s.dx_next, f_next))
+                };
+                if let Some((xr, yr)) = right {
+                    if (yi - yl) * (xr - xl) <= (yr - yl) * (dx(i) - xl) {
+                        continue;
+                    }
+                }
+                st.pop_while(s.xs[i], yi);
+                st.push(s.xs[i], yi);
             }
-            pop_while(stack, (s.xs[i], yi));
-            stack.push((s.xs[i], yi));
+            st.pop_while(s.xp, fp);
         }
-        pop_while(stack, (s.xp, fp));
-        stack.push((s.xp, fp));
+        st.push(s.xp, fp);
         near.max(far)
     }
 }
 
-/// Pop the top vertex while it is not above the segment from q to the one below it (for a
-/// push), which is the same test as its slope from q being at most the next one's (for a
-/// tangent query from q).
-#[inline]
-fn pop_while(stack: &mut Vec<(i32, f32)>, (xq, yq): (i32, f32)) {
-    while let [.., (x2, y2), (x1, y1)] = stack[..] {
-        if (y1 - yq) * (x2 - xq) as f32 <= (y2 - yq) * (x1 - xq) as f32 {
-            stack.pop();
-        } else {
-            break;
+/// A lane's hull in the portable kernel: a buffer sized by `reset`, with its length.
+struct LaneStack {
+    buf: Vec<(i32, f32)>,
+    len: usize,
+}
+
+impl LaneStack {
+    #[inline(always)]
+    fn top(&self) -> (i32, f32) {
+        self.buf[self.len - 1]
+    }
+    #[inline(always)]
+    fn push(&mut self, x: i32, y: f32) {
+        self.buf[self.len] = (x, y);
+        self.len += 1;
+    }
+    #[inline(always)]
+    fn pop_while(&mut self, xq: i32, yq: f32) {
+        let mut n = self.len;
+        while n >= 2 {
+            let (x1, y1) = self.buf[n - 1];
+            let (x2, y2) = self.buf[n - 2];
+            if (y1 - yq) * (x2 - xq) as f32 <= (y2 - yq) * (x1 - xq) as f32 {
+                n -= 1;
+            } else {
+                break;
+            }
         }
+        self.len = n;
     }
 }
 
@@ -219,11 +261,13 @@ impl HullsF32 {
         let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
         let zero = _mm256_setzero_si256();
         let (zp, on, count) = (ld_f(&l.zp), ld_i(&l.on), ld_i(&l.count));
-        // 1. Near.
+        // 1. Near; the period's largest slope and its last index.
         let mut near = _mm256_mul_ps(
             _mm256_sub_ps(ld_f(&l.own), _mm256_set1_ps(s.own_drop)),
             _mm256_set1_ps(s.own_inv),
         );
+        let mut best = _mm256_set1_ps(f32::NEG_INFINITY);
+        let mut first = zero;
         for i in 0..s.xs.len() {
             let has = _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
             let v = _mm256_mul_ps(
@@ -233,8 +277,20 @@ impl HullsF32 {
                 ),
                 _mm256_set1_ps(*s.near_inv.get_unchecked(i)),
             );
-            near = _mm256_blendv_ps(near, _mm256_max_ps(near, v), _mm256_castsi256_ps(has));
+            let v = _mm256_blendv_ps(
+                _mm256_set1_ps(f32::NEG_INFINITY),
+                v,
+                _mm256_castsi256_ps(has),
+            );
+            let ge = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(v, best));
+            first = _mm256_blendv_epi8(
+                first,
+                _mm256_set1_epi32(i as i32),
+                _mm256_and_si256(ge, has),
+            );
+            best = _mm256_max_ps(best, v);
         }
+        near = _mm256_max_ps(near, best);
         // The top two vertices of every lane: slot, height, τ.
         let top = |k: usize| Top {
             slot: ld_i(&self.top[k]),
@@ -283,6 +339,13 @@ impl HullsF32 {
             ($m:expr, $xq:expr, $yq:expr) => {{
                 let (m, xq, yq) = ($m, $xq, $yq);
                 pop_while!(m, xq, yq);
+                record!(m, xq, yq);
+            }};
+        }
+        // Record (xq, yq) on top in the lanes of mask m, in a new slot (no pops).
+        macro_rules! record {
+            ($m:expr, $xq:expr, $yq:expr) => {{
+                let (m, xq, yq) = ($m, $xq, $yq);
                 let at = self.slot * LANES;
                 _mm256_storeu_si256(below.add(at) as *mut __m256i, v1.slot);
                 _mm256_storeu_ps(below_y.add(at), v1.y);
@@ -312,7 +375,10 @@ impl HullsF32 {
         );
         let empty = _mm256_castsi256_ps(_mm256_cmpeq_epi32(v1.slot, zero));
         let far = _mm256_blendv_ps(far, _mm256_set1_ps(f32::NEG_INFINITY), empty);
-        // 3. The period's samples above the chord from P to P′ (all of them where P′ is off).
+        // 3. Where the period's largest slope beats the far one, its samples from m on that lie
+        // above the chord from P to P′ (all of them where P′ is off) and their neighbours.
+        let active = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(best, far));
+        let mut pushed = false;
         let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
         let rise = _mm256_sub_ps(f_next, fp);
         let dx_next = _mm256_set1_ps(s.dx_next);
@@ -350,13 +416,22 @@ impl HullsF32 {
             );
             let has = has_at(i);
             (xr, yr, has_r) = (dxv, y, has);
-            let m = _mm256_andnot_si256(skip, _mm256_and_si256(has, on));
+            let from = _mm256_and_si256(
+                active,
+                _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), first),
+            );
+            let m = _mm256_andnot_si256(skip, _mm256_and_si256(_mm256_and_si256(has, on), from));
             if _mm256_testz_si256(m, m) == 0 {
                 push!(m, _mm256_set1_epi32(xi), y);
+                pushed = true;
             }
         }
         // 4. P itself.
-        push!(on, xp, fp);
+        if pushed {
+            push!(on, xp, fp);
+        } else {
+            record!(on, xp, fp);
+        }
         let st_i = |a: &mut [i32; LANES], v: __m256i| {
             _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, v)
         };
