@@ -35,6 +35,7 @@ pub mod voxel_size;
 pub mod voxelize;
 pub mod watertight;
 pub mod wide_bvh;
+pub mod wide_collapse;
 
 pub use matrix::TransportMatrix;
 use serde::{Deserialize, Serialize};

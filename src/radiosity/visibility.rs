@@ -2,8 +2,9 @@
 //! Two queries: the closest hit (hemisphere shooting) and occlusion of a segment (pairwise form
 //! factors, patch clustering, the transfer's leak test).
 //!
-//! obvhs builds the tree (a compressed-wide BVH, its highest-quality preset); [`WideBvh`] keeps
-//! its shape with exact f32 child boxes and traverses it with AVX2 slab tests (wide_bvh.rs).
+//! obvhs builds a binary tree (its highest-quality preset), [`wide_collapse`] makes it 8-wide
+//! with leaves of up to four triangles, and [`WideBvh`] gives it exact f32 child boxes and
+//! traverses it with AVX2 slab tests (wide_bvh.rs).
 //! Triangles are tested with a watertight intersection (no rays lost through shared edges).
 //! Rays start `BACKOFF` behind their origin (see there). The closest hit is order-independent:
 //! of two hits at the same distance (a shared edge) the lower leaf slot wins.
@@ -11,12 +12,11 @@
 use super::geometry::Frame;
 use super::watertight::{TriangleBlocks, Watertight};
 use super::wide_bvh::{AnyLeaf, BoxRay, ClosestLeaf, WideBvh};
+use super::wide_collapse;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3A};
-use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
-use std::time::Duration;
 
 /// The scene's non-degenerate triangles in a BVH.
 pub struct Visibility {
@@ -89,9 +89,13 @@ impl Visibility {
         // obvhs's highest-quality preset: on the furnished room (78,324 triangles) it traces
         // 2.3x the rays per second of `slow_build` for 2x its build time (0.15 s against
         // 0.07 s), where the form-factor stage casts millions of rays (benches/visibility_embree.rs).
-        let cw = build_cwbvh_from_tris(&tris, params, &mut Duration::default());
-        let bvh = WideBvh::from_cwbvh(&cw, |i| {
-            let t = &tris[cw.primitive_indices[i] as usize];
+        let collapsed = if tris.is_empty() {
+            Vec::new()
+        } else {
+            wide_collapse::collapse(&wide_collapse::build_bvh2(&tris, &params))
+        };
+        let (bvh, order) = WideBvh::from_collapsed(&collapsed, |k| {
+            let t = &tris[k as usize];
             (
                 t.v0.min(t.v1).min(t.v2).to_array(),
                 t.v0.max(t.v1).max(t.v2).to_array(),
@@ -100,7 +104,7 @@ impl Visibility {
         let mut blocks = TriangleBlocks::default();
         let mut info = Vec::with_capacity(4 * bvh.leaves().len());
         for &(first, count) in bvh.leaves() {
-            let ks = &cw.primitive_indices[first as usize..(first + count) as usize];
+            let ks = &order[first as usize..(first + count) as usize];
             let leaf: Vec<[Vec3A; 3]> = ks
                 .iter()
                 .map(|&k| {

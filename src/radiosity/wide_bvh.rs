@@ -7,16 +7,16 @@
 //! boxes stored as 6 × 8 floats, a child's entry distance from one fused multiply-subtract per
 //! plane) is what `benches/visibility_embree.rs` measures against it.
 //!
-//! The tree's *shape* is obvhs's: [`WideBvh::from_cwbvh`] keeps every node, child slot and leaf
-//! of a [`CwBvh`] (its PLOC build and reinsertion optimiser make the tree quality that matters
-//! most, see docs/radiosity.md), and replaces the quantised child boxes by exact ones refitted
-//! from the primitives' own boxes.
+//! The tree's *shape* comes from obvhs's binary tree (its PLOC build and reinsertion optimiser
+//! make the tree quality that matters most, see docs/radiosity.md), collapsed to eight children
+//! and leaves of up to four triangles by [`super::wide_collapse`]; the child boxes are exact,
+//! refitted from the primitives' own boxes.
 //!
 //! Preconditions: primitive boxes are finite. The traversal is conservative: a child box is
 //! entered whenever the exact ray meets it (the rounding argument is at [`BoxRay`]), so a leaf
 //! test that hits a primitive in exact arithmetic is always reached.
 
-use obvhs::cwbvh::CwBvh;
+use super::wide_collapse::Child;
 
 /// A child reference: a node index, or a leaf (`LEAF` bit set): `LEAF | leaf << 3 | count`, the
 /// leaf's number (its position in [`WideBvh::leaves`], depth-first order) and its primitive count.
@@ -62,7 +62,8 @@ impl Node {
 /// The tree. Leaf tests get a leaf's number; [`WideBvh::leaves`] maps it to its primitives.
 pub struct WideBvh {
     nodes: Vec<Node>,
-    /// Each leaf's primitives as (first, count): positions in the `CwBvh`'s `primitive_indices`.
+    /// Each leaf's primitives as (first, count): positions in the primitive order of
+    /// [`WideBvh::from_collapsed`].
     leaves: Vec<(u32, u32)>,
     root: u32,
     avx2: bool,
@@ -145,34 +146,45 @@ pub trait AnyLeaf {
 }
 
 impl WideBvh {
-    /// The tree of `bvh`, with exact child boxes: `prim_box(i)` is the box of primitive slot `i`
-    /// (`bvh.primitive_indices[i]`'s primitive) as (min, max).
-    pub fn from_cwbvh(bvh: &CwBvh, prim_box: impl Fn(usize) -> ([f32; 3], [f32; 3])) -> Self {
+    /// The tree of the collapsed `nodes` ([`super::wide_collapse::collapse`]), with exact child
+    /// boxes: `prim_box(p)` is the box of primitive `p` as (min, max). Returns the tree and the
+    /// primitives in leaf order ([`WideBvh::leaves`] indexes them).
+    pub fn from_collapsed(
+        nodes: &[Vec<Child>],
+        prim_box: impl Fn(u32) -> ([f32; 3], [f32; 3]),
+    ) -> (Self, Vec<u32>) {
         let avx2 = crate::cpu::has_avx2_fma();
-        if bvh.nodes.is_empty() || bvh.primitive_indices.is_empty() {
-            return WideBvh {
+        if nodes.is_empty() {
+            let empty = WideBvh {
                 nodes: Vec::new(),
                 leaves: Vec::new(),
                 root: EMPTY,
                 avx2,
                 margin: 0.0,
             };
+            return (empty, Vec::new());
         }
-        let mut nodes = vec![Node::EMPTY; bvh.nodes.len()];
-        let mut leaves = Vec::new();
-        let (lo, hi) = refit(bvh, 0, &prim_box, &mut nodes, &mut leaves);
+        let mut tree = Refit {
+            src: nodes,
+            prim_box: &prim_box,
+            nodes: vec![Node::EMPTY; nodes.len()],
+            leaves: Vec::new(),
+            order: Vec::new(),
+        };
+        let (lo, hi) = tree.node(0);
         let largest = lo.iter().chain(&hi).fold(0.0f32, |m, x| m.max(x.abs()));
-        WideBvh {
-            nodes,
-            leaves,
+        let bvh = WideBvh {
+            nodes: tree.nodes,
+            leaves: tree.leaves,
             root: 0,
             avx2,
             margin: largest * (1.0 / (1 << 18) as f32),
-        }
+        };
+        (bvh, tree.order)
     }
 
-    /// Each leaf's primitives as (first, count), by leaf number: positions in the `CwBvh`'s
-    /// `primitive_indices`; count ≤ 3.
+    /// Each leaf's primitives as (first, count), by leaf number: positions in the primitive
+    /// order that [`WideBvh::from_collapsed`] returned; count ≤ 4.
     pub fn leaves(&self) -> &[(u32, u32)] {
         &self.leaves
     }
@@ -386,43 +398,46 @@ impl<T: Copy> Stack<T> {
     }
 }
 
-/// Fill `nodes[index]` from the CWBVH node of the same index and return its exact box.
-fn refit(
-    bvh: &CwBvh,
-    index: usize,
-    prim_box: &impl Fn(usize) -> ([f32; 3], [f32; 3]),
-    nodes: &mut [Node],
-    leaves: &mut Vec<(u32, u32)>,
-) -> ([f32; 3], [f32; 3]) {
-    let src = bvh.nodes[index];
-    let mut whole = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    let mut internal = 0u32;
-    for slot in 0..8 {
-        let meta = src.child_meta[slot];
-        if meta == 0 {
-            continue;
+/// The exact boxes of a collapsed tree, filled from its root.
+struct Refit<'a, F> {
+    src: &'a [Vec<Child>],
+    prim_box: &'a F,
+    nodes: Vec<Node>,
+    leaves: Vec<(u32, u32)>,
+    order: Vec<u32>,
+}
+
+impl<F: Fn(u32) -> ([f32; 3], [f32; 3])> Refit<'_, F> {
+    /// Fill `nodes[index]` from the collapsed node of the same index and return its exact box.
+    fn node(&mut self, index: usize) -> ([f32; 3], [f32; 3]) {
+        let src = self.src;
+        let mut whole = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        assert!(src[index].len() <= 8, "a node has at most eight children");
+        for (slot, child) in src[index].iter().enumerate() {
+            let (reference, b) = match child {
+                Child::Node(c) => (*c as u32, self.node(*c)),
+                Child::Leaf(prims) => {
+                    assert!(
+                        (1..=4).contains(&prims.len()),
+                        "a leaf holds 1 to 4 primitives"
+                    );
+                    let mut b = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+                    for &p in prims {
+                        b = union(b, (self.prim_box)(p));
+                    }
+                    let id = self.leaves.len() as u32;
+                    assert!(id < 1 << 28, "more leaves than a reference can address");
+                    self.leaves
+                        .push((self.order.len() as u32, prims.len() as u32));
+                    self.order.extend_from_slice(prims);
+                    (LEAF | id << 3 | prims.len() as u32, b)
+                }
+            };
+            self.nodes[index].set(slot, b, reference);
+            whole = union(whole, b);
         }
-        let (child, (lo, hi)) = if src.imask & (1 << slot) != 0 {
-            let child = src.child_base_idx + internal;
-            internal += 1;
-            (child, refit(bvh, child as usize, prim_box, nodes, leaves))
-        } else {
-            let first = src.primitive_base_idx + (meta & 0b1_1111) as u32;
-            let count = (meta >> 5).count_ones();
-            let mut b = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            for p in first..first + count {
-                let (lo, hi) = prim_box(p as usize);
-                b = union(b, (lo, hi));
-            }
-            let id = leaves.len() as u32;
-            assert!(id < 1 << 28, "more leaves than a reference can address");
-            leaves.push((first, count));
-            (LEAF | id << 3 | count, b)
-        };
-        nodes[index].set(slot, (lo, hi), child);
-        whole = union(whole, (lo, hi));
+        whole
     }
-    whole
 }
 
 fn union(a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])) -> ([f32; 3], [f32; 3]) {
