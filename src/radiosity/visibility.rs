@@ -15,8 +15,10 @@ use super::wide_bvh::{AnyLeaf, BoxRay, ClosestLeaf, WideBvh};
 use super::wide_collapse;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3A};
+use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+use std::time::Duration;
 
 /// The scene's non-degenerate triangles in a BVH.
 pub struct Visibility {
@@ -92,7 +94,13 @@ impl Visibility {
         let collapsed = if tris.is_empty() {
             Vec::new()
         } else {
-            wide_collapse::collapse(&wide_collapse::build_bvh2(&tris, &params))
+            // Leaves of one triangle, as the collapse takes them.
+            let params = BvhBuildParams {
+                max_prims_per_leaf: 1,
+                ..params
+            };
+            let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
+            wide_collapse::collapse(&bvh2)
         };
         let (bvh, order) = WideBvh::from_collapsed(&collapsed, |k| {
             let t = &tris[k as usize];

@@ -16,7 +16,7 @@
 //! entered whenever the exact ray meets it (the rounding argument is at [`BoxRay`]), so a leaf
 //! test that hits a primitive in exact arithmetic is always reached.
 
-use super::wide_collapse::Child;
+use super::wide_collapse::{Child, MAX_LEAF};
 
 /// A child reference: a node index, or a leaf (`LEAF` bit set): `LEAF | leaf << 3 | count`, the
 /// leaf's number (its position in [`WideBvh::leaves`], depth-first order) and its primitive count.
@@ -418,8 +418,8 @@ impl<F: Fn(u32) -> ([f32; 3], [f32; 3])> Refit<'_, F> {
                 Child::Node(c) => (*c as u32, self.node(*c)),
                 Child::Leaf(prims) => {
                     assert!(
-                        (1..=4).contains(&prims.len()),
-                        "a leaf holds 1 to 4 primitives"
+                        (1..=MAX_LEAF as usize).contains(&prims.len()),
+                        "a leaf holds 1 to {MAX_LEAF} primitives"
                     );
                     let mut b = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
                     for &p in prims {

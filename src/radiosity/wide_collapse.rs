@@ -1,5 +1,6 @@
-//! The shape of the 8-wide tree: obvhs builds a binary tree (PLOC over pre-split boxes, then
-//! its reinsertion optimiser: the tree quality that matters most), and this collapses it into
+//! The shape of the 8-wide tree: obvhs builds a binary tree with leaves of one triangle
+//! (`build_bvh2_from_tris`: PLOC over pre-split boxes, then its reinsertion optimiser, twice:
+//! the tree quality that matters most), and this collapses it into
 //! nodes of up to eight children and leaves of up to four triangles by the dynamic programme of
 //! Ylitie, Karras and Laine ("Efficient incoherent ray traversal on GPUs through compressed
 //! wide BVHs", HPG 2017), as obvhs's own CWBVH conversion does, with two differences:
@@ -15,7 +16,7 @@
 //! `get_children` then lists each node's up to eight children as obvhs does.
 //!
 //! Preconditions: at least one primitive, and every leaf of the binary tree holds exactly one
-//! (PLOC's output).
+//! (`build_bvh2_from_tris` with `max_prims_per_leaf: 1`).
 
 use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::bvh2_to_cwbvh::{Bvh2Converter, Decision, DecisionKind};
@@ -59,7 +60,8 @@ fn node(conv: &mut Bvh2Converter, n2: usize, out: &mut Vec<Vec<Child>>) -> usize
     let mut list = Vec::with_capacity(count as usize);
     for &c in &children[..count as usize] {
         let c = c as usize;
-        let leaf = conv.bvh2.nodes[c].is_leaf() || conv.decisions[c * 7].kind == DecisionKind::LEAF;
+        // A binary leaf's decisions are all LEAF (`costs`).
+        let leaf = conv.decisions[c * 7].kind == DecisionKind::LEAF;
         list.push(if leaf {
             Child::Leaf(primitives(conv.bvh2, c))
         } else {
@@ -152,39 +154,6 @@ fn costs(dec: &mut [Decision], bvh2: &Bvh2, n: usize) -> u32 {
     count
 }
 
-/// obvhs's binary tree over `tris` with the build settings `params`, as its
-/// `build_cwbvh_from_tris` makes it before the CWBVH conversion: pre-split boxes when asked,
-/// PLOC, then reinsertion.
-pub fn build_bvh2(tris: &[obvhs::triangle::Triangle], params: &obvhs::BvhBuildParams) -> Bvh2 {
-    use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
-    use obvhs::ploc::PlocBuilder;
-    let mut bvh2 = if params.pre_split {
-        let mut aabbs: Vec<_> = tris.iter().map(|t| t.aabb()).collect();
-        let largest = aabbs.iter().map(|a| a.half_area()).fold(0.0f32, f32::max);
-        let average = aabbs.iter().map(|a| a.half_area()).sum::<f32>() / tris.len() as f32;
-        let mut indices: Vec<u32> = (0..tris.len() as u32).collect();
-        obvhs::splits::split_aabbs_preset(&mut aabbs, &mut indices, tris, average, largest);
-        PlocBuilder::with_capacity(aabbs.len()).build(
-            params.ploc_search_distance,
-            &aabbs,
-            indices,
-            params.sort_precision,
-            params.search_depth_threshold,
-        )
-    } else {
-        PlocBuilder::with_capacity(tris.len()).build(
-            params.ploc_search_distance,
-            tris,
-            (0..tris.len() as u32).collect(),
-            params.sort_precision,
-            params.search_depth_threshold,
-        )
-    };
-    bvh2.uses_spatial_splits = params.pre_split;
-    ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-    bvh2
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,7 +198,12 @@ mod tests {
                 pre_split,
                 ..obvhs::BvhBuildParams::very_slow_build()
             };
-            let nodes = collapse(&build_bvh2(&tris, &params));
+            let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(
+                &tris,
+                obvhs::BvhBuildParams { max_prims_per_leaf: 1, ..params },
+                &mut std::time::Duration::default(),
+            );
+            let nodes = collapse(&bvh2);
             let mut parents = vec![0usize; nodes.len()];
             let mut seen = vec![0usize; n];
             for children in &nodes {

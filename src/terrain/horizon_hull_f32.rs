@@ -267,7 +267,7 @@ impl HullsF32 {
             _mm256_set1_ps(s.own_inv),
         );
         let mut best = _mm256_set1_ps(f32::NEG_INFINITY);
-        let mut first = zero;
+        let mut argmax = zero;
         for i in 0..s.xs.len() {
             let has = _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
             let v = _mm256_mul_ps(
@@ -283,8 +283,8 @@ impl HullsF32 {
                 _mm256_castsi256_ps(has),
             );
             let ge = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(v, best));
-            first = _mm256_blendv_epi8(
-                first,
+            argmax = _mm256_blendv_epi8(
+                argmax,
                 _mm256_set1_epi32(i as i32),
                 _mm256_and_si256(ge, has),
             );
@@ -418,7 +418,7 @@ impl HullsF32 {
             (xr, yr, has_r) = (dxv, y, has);
             let from = _mm256_and_si256(
                 active,
-                _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), first),
+                _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), argmax),
             );
             let m = _mm256_andnot_si256(skip, _mm256_and_si256(_mm256_and_si256(has, on), from));
             if _mm256_testz_si256(m, m) == 0 {
