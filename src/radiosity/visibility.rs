@@ -286,19 +286,21 @@ struct Occluding<'a> {
 impl AnyLeaf for Occluding<'_> {
     #[inline(always)]
     fn leaf(&mut self, leaf: u32, count: u32) -> bool {
-        let ts =
-            self.vis
-                .blocks
-                .intersect4(self.wt, leaf as usize, count as usize, BACKOFF, self.tmax);
-        // Lanes past `count` are infinite. Without branches per lane: a hit beyond the
-        // epsilon stops the ray ([`Visibility::counts`]); only a nearer one needs its normal.
-        if ts.iter().fold(false, |a, &t| {
-            a | (t != f32::INFINITY && t - BACKOFF >= self.vis.epsilon)
-        }) {
+        let lanes = self.vis.blocks.hits4(
+            self.wt,
+            leaf as usize,
+            count as usize,
+            (BACKOFF, self.tmax),
+            self.vis.epsilon,
+        );
+        // A hit beyond the epsilon stops the ray ([`Visibility::counts`]); only a nearer one
+        // needs its normal.
+        if lanes.hit & !lanes.near != 0 {
             return true;
         }
-        ts.iter().fold(false, |a, &t| a | (t != f32::INFINITY))
-            && (0..count as usize).any(|k| self.vis.counts(4 * leaf + k as u32, ts[k], self.d))
+        lanes.near != 0
+            && (0..count as usize)
+                .any(|k| self.vis.counts(4 * leaf + k as u32, lanes.ts[k], self.d))
     }
 }
 
@@ -314,11 +316,24 @@ struct Closest<'a> {
 impl ClosestLeaf for Closest<'_> {
     #[inline(always)]
     fn leaf(&mut self, leaf: u32, count: u32, mut tmax: f32) -> f32 {
-        let ts = self
-            .vis
-            .blocks
-            .intersect4(self.wt, leaf as usize, count as usize, BACKOFF, tmax);
-        for (k, &t) in ts.iter().enumerate().take(count as usize) {
+        let ((t, lane), lanes) = self.vis.blocks.nearest4(
+            self.wt,
+            leaf as usize,
+            count as usize,
+            (BACKOFF, tmax),
+            self.vis.epsilon,
+        );
+        if lanes.near == 0 {
+            // Every hit lies beyond the epsilon and counts ([`Visibility::counts`]); distances
+            // are at most `tmax`, so the nearest lane wins unless it ties a lower slot.
+            let s = 4 * leaf + lane;
+            if lanes.hit != 0 && (t < tmax || s < self.best) {
+                self.best = s;
+                return t;
+            }
+            return tmax;
+        }
+        for (k, &t) in lanes.ts.iter().enumerate().take(count as usize) {
             let s = 4 * leaf + k as u32;
             if !self.vis.counts(s, t, self.d) {
                 continue;

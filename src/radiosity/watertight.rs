@@ -132,8 +132,13 @@ impl TriangleBlocks {
     ) -> [f32; 4] {
         #[cfg(target_arch = "x86_64")]
         {
-            // SAFETY: SSE2 is part of x86_64.
-            unsafe { self.intersect4_sse(wt, block, count, tmin, tmax) }
+            let mut out = [0.0f32; 4];
+            // SAFETY: SSE2 is part of x86_64; `out` holds four f32.
+            unsafe {
+                let t = self.intersect4_sse(wt, block, count, tmin, tmax);
+                std::arch::x86_64::_mm_storeu_ps(out.as_mut_ptr(), t);
+            }
+            out
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
@@ -156,7 +161,7 @@ impl TriangleBlocks {
         count: usize,
         tmin: f32,
         tmax: f32,
-    ) -> [f32; 4] {
+    ) -> std::arch::x86_64::__m128 {
         use std::arch::x86_64::*;
         let [kx, ky, kz] = wt.axes;
         let o = wt.origin.to_array();
@@ -213,25 +218,134 @@ impl TriangleBlocks {
             _mm_set1_epi32(count as i32),
         ));
         let hit = _mm_and_ps(_mm_andnot_ps(miss, inside), used);
-        let mut out = [0.0f32; 4];
-        _mm_storeu_ps(
-            out.as_mut_ptr(),
-            _mm_blendv_or(hit, t, _mm_set1_ps(f32::INFINITY)),
-        );
+        let out = _mm_blendv_or(hit, t, _mm_set1_ps(f32::INFINITY));
         // A zero edge function is decided again in f64 (the ray meets an edge's line): those
         // lanes take the scalar path, which does exactly that.
         let edge = _mm_or_ps(
             _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
             _mm_cmpeq_ps(w, zero),
         );
-        let mut redo = _mm_movemask_ps(edge) as u32 & lanes;
+        let redo = _mm_movemask_ps(edge) as u32 & lanes;
+        if redo == 0 {
+            out
+        } else {
+            self.redo(wt, block, redo, out, tmin, tmax)
+        }
+    }
+
+    /// The lanes of `redo` by the scalar test, the others as in `out`: out of line, so that the
+    /// rare path's calls do not make the vector test spill its registers.
+    #[cfg(target_arch = "x86_64")]
+    #[cold]
+    #[inline(never)]
+    fn redo(
+        &self,
+        wt: &Watertight,
+        block: usize,
+        mut redo: u32,
+        out: std::arch::x86_64::__m128,
+        tmin: f32,
+        tmax: f32,
+    ) -> std::arch::x86_64::__m128 {
+        use std::arch::x86_64::*;
+        let mut lanes = [0.0f32; 4];
+        // SAFETY: SSE2 is part of x86_64; `lanes` holds four f32.
+        unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), out) };
         while redo != 0 {
             let k = redo.trailing_zeros() as usize;
             redo &= redo - 1;
-            out[k] = wt.intersect(&self.triangle(block, k), tmin, tmax);
+            lanes[k] = wt.intersect(&self.triangle(block, k), tmin, tmax);
         }
-        out
+        // SAFETY: as above.
+        unsafe { _mm_loadu_ps(lanes.as_ptr()) }
     }
+
+    /// [`TriangleBlocks::intersect4`]'s distances with two masks computed in the vector
+    /// registers: the lanes hit, and those hit less than `epsilon` past `tmin` (`t − tmin <
+    /// epsilon`, in f32), which need a second look.
+    #[inline(always)]
+    pub fn hits4(
+        &self,
+        wt: &Watertight,
+        block: usize,
+        count: usize,
+        (tmin, tmax): (f32, f32),
+        epsilon: f32,
+    ) -> Lanes4 {
+        self.nearest4_with(wt, block, count, (tmin, tmax), epsilon, false)
+            .1
+    }
+
+    /// [`TriangleBlocks::hits4`] and the nearest lane: the smallest distance (infinity when every
+    /// lane missed) and its lowest lane.
+    #[inline(always)]
+    pub fn nearest4(
+        &self,
+        wt: &Watertight,
+        block: usize,
+        count: usize,
+        (tmin, tmax): (f32, f32),
+        epsilon: f32,
+    ) -> ((f32, u32), Lanes4) {
+        self.nearest4_with(wt, block, count, (tmin, tmax), epsilon, true)
+    }
+
+    #[inline(always)]
+    fn nearest4_with(
+        &self,
+        wt: &Watertight,
+        block: usize,
+        count: usize,
+        (tmin, tmax): (f32, f32),
+        epsilon: f32,
+        nearest: bool,
+    ) -> ((f32, u32), Lanes4) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of x86_64.
+        unsafe {
+            use std::arch::x86_64::*;
+            let t = self.intersect4_sse(wt, block, count, tmin, tmax);
+            let mut ts = [0.0f32; 4];
+            _mm_storeu_ps(ts.as_mut_ptr(), t);
+            let near = _mm_cmplt_ps(_mm_sub_ps(t, _mm_set1_ps(tmin)), _mm_set1_ps(epsilon));
+            let lanes = Lanes4 {
+                hit: _mm_movemask_ps(_mm_cmplt_ps(t, _mm_set1_ps(f32::INFINITY))) as u32,
+                near: _mm_movemask_ps(near) as u32,
+                ts,
+            };
+            if !nearest {
+                return ((f32::INFINITY, 0), lanes);
+            }
+            let m = _mm_min_ps(t, _mm_shuffle_ps::<0b01_00_11_10>(t, t));
+            let m = _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m));
+            // Some lane equals the minimum (no NaN arises), so the mask is not empty.
+            let lane = (_mm_movemask_ps(_mm_cmpeq_ps(t, m)) as u32).trailing_zeros();
+            ((_mm_cvtss_f32(m), lane), lanes)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let ts = self.intersect4(wt, block, count, tmin, tmax);
+            let mask = |f: &dyn Fn(f32) -> bool| (0..4).fold(0, |m, k| m | (f(ts[k]) as u32) << k);
+            let lanes = Lanes4 {
+                hit: mask(&|t| t < f32::INFINITY),
+                near: mask(&|t| t - tmin < epsilon),
+                ts,
+            };
+            let t = ts.iter().fold(f32::INFINITY, |a, &b| a.min(b));
+            let lane = ts.iter().position(|&x| x == t).unwrap_or(0) as u32;
+            ((t, lane), lanes)
+        }
+    }
+}
+
+/// [`TriangleBlocks::hits4`]'s lanes.
+pub struct Lanes4 {
+    /// Every lane's distance (infinity for a miss).
+    pub ts: [f32; 4],
+    /// Lanes hit.
+    pub hit: u32,
+    /// Lanes hit less than the epsilon past `tmin` (a subset of `hit`).
+    pub near: u32,
 }
 
 /// `mask ? a : b` lane-wise with SSE2 only.
