@@ -211,7 +211,14 @@ impl WideBvh {
     }
 
     /// True when some leaf test reports a hit: `leaf.leaf(leaf, count)` is asked for every leaf whose
-    /// box the ray meets in `[tmin, tmax]`, in no particular order, until one says true.
+    /// box the ray meets in `[tmin, tmax]` until one says true.
+    ///
+    /// Order: a node's children sit in its slots largest box first (half surface area), and
+    /// the traversal takes them in slot order: its hit leaves first, then its hit inner
+    /// children (the first visited next, the others pushed last slot first, so popped in slot
+    /// order). A larger box is more likely to hold what stops the ray; on the furnished room
+    /// this order made occlusion 8–10 % faster than the collapse's own child order
+    /// (docs/radiosity.md, stop 46).
     pub fn any(&self, ray: &BoxRay, tmin: f32, tmax: f32, leaf: &mut impl AnyLeaf) -> bool {
         if self.root == EMPTY {
             return false;
@@ -342,8 +349,8 @@ impl WideBvh {
                 current = node.child[k];
                 assert!(sp + 8 <= STACK, "BVH traversal stack overflow");
                 while inner != 0 {
-                    let k = inner.trailing_zeros() as usize;
-                    inner &= inner - 1;
+                    let k = 31 - inner.leading_zeros() as usize;
+                    inner &= !(1 << k);
                     // SAFETY: sp + 7 < STACK, checked above.
                     unsafe { items.get_unchecked_mut(sp).write(node.child[k]) };
                     sp += 1;
@@ -413,7 +420,8 @@ impl<F: Fn(u32) -> ([f32; 3], [f32; 3])> Refit<'_, F> {
         let src = self.src;
         let mut whole = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
         assert!(src[index].len() <= 8, "a node has at most eight children");
-        for (slot, child) in src[index].iter().enumerate() {
+        let mut slots = Vec::with_capacity(8);
+        for child in src[index].iter() {
             let (reference, b) = match child {
                 Child::Node(c) => (*c as u32, self.node(*c)),
                 Child::Leaf(prims) => {
@@ -433,11 +441,22 @@ impl<F: Fn(u32) -> ([f32; 3], [f32; 3])> Refit<'_, F> {
                     (LEAF | id << 3 | prims.len() as u32, b)
                 }
             };
-            self.nodes[index].set(slot, b, reference);
+            slots.push((half_area(b), b, reference));
             whole = union(whole, b);
+        }
+        // Largest box first: see the occlusion traversal in [`WideBvh::any`].
+        slots.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (slot, (_, b, reference)) in slots.into_iter().enumerate() {
+            self.nodes[index].set(slot, b, reference);
         }
         whole
     }
+}
+
+/// Half the surface area of the box `lo..hi`.
+fn half_area((lo, hi): ([f32; 3], [f32; 3])) -> f32 {
+    let e: [f32; 3] = std::array::from_fn(|k| hi[k] - lo[k]);
+    e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
 }
 
 fn union(a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])) -> ([f32; 3], [f32; 3]) {
@@ -595,6 +614,62 @@ mod tests {
                     }
                 }
             }
+        }
+
+        /// The refit keeps every child and puts a node's children largest box first, each
+        /// slot holding the exact union of its primitives' boxes.
+        #[test]
+        fn refit_puts_children_largest_box_first(
+            sizes in prop::collection::vec((0u8..4, prop::array::uniform3(0.0f32..4.0), prop::array::uniform3(0.01f32..3.0)), 2..=8),
+        ) {
+            // A root whose children are one-primitive leaves and, for a size of 0, a node of two.
+            let mut boxes = Vec::new();
+            let mut nodes: Vec<Vec<Child>> = vec![Vec::new()];
+            for (kind, lo, e) in &sizes {
+                let b = (*lo, std::array::from_fn(|k| lo[k] + e[k]));
+                if *kind == 0 {
+                    let half = (*lo, std::array::from_fn(|k| lo[k] + 0.5 * e[k]));
+                    boxes.extend([b, half]);
+                    let n = boxes.len() as u32;
+                    let c = nodes.len();
+                    nodes[0].push(Child::Node(c));
+                    nodes.push(vec![Child::Leaf(vec![n - 2]), Child::Leaf(vec![n - 1])]);
+                } else {
+                    boxes.push(b);
+                    nodes[0].push(Child::Leaf(vec![boxes.len() as u32 - 1]));
+                }
+            }
+            let (bvh, order) = WideBvh::from_collapsed(&nodes, |p| boxes[p as usize]);
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            prop_assert_eq!(sorted, (0..boxes.len() as u32).collect::<Vec<_>>());
+            for node in &bvh.nodes {
+                let used: Vec<_> = (0..8).filter(|&k| node.child[k] != EMPTY).collect();
+                let area: Vec<f32> = used
+                    .iter()
+                    .map(|&k| half_area((
+                        std::array::from_fn(|a| node.planes[a][k]),
+                        std::array::from_fn(|a| node.planes[3 + a][k]),
+                    )))
+                    .collect();
+                prop_assert!(area.windows(2).all(|w| w[0] >= w[1]), "slots out of order: {:?}", area);
+                prop_assert_eq!(used.len(), used.last().map_or(0, |&k| k + 1), "slots not packed");
+            }
+            // Root slots hold exactly the children's boxes (a node child: the first of its two).
+            let root = &bvh.nodes[0];
+            let mut found: Vec<[u32; 6]> = (0..sizes.len())
+                .map(|k| std::array::from_fn(|r| root.planes[r][k].to_bits()))
+                .collect();
+            let mut want: Vec<[u32; 6]> = sizes
+                .iter()
+                .map(|(_, lo, e)| {
+                    let hi: [f32; 3] = std::array::from_fn(|k| lo[k] + e[k]);
+                    std::array::from_fn(|r| if r < 3 { lo[r] } else { hi[r - 3] }.to_bits())
+                })
+                .collect();
+            found.sort_unstable();
+            want.sort_unstable();
+            prop_assert_eq!(found, want);
         }
     }
 }
