@@ -10,7 +10,8 @@
 //! The tree's *shape* comes from obvhs's binary tree (its PLOC build and reinsertion optimiser
 //! make the tree quality that matters most, see docs/radiosity.md), collapsed to eight children
 //! and leaves of up to four triangles by [`super::wide_collapse`]; the child boxes are exact,
-//! refitted from the primitives' own boxes.
+//! refitted from the primitives' own boxes, and sit in their node's slots largest first (the
+//! order occlusion visits them in, [`WideBvh::any`]).
 //!
 //! Preconditions: primitive boxes are finite. The traversal is conservative: a child box is
 //! entered whenever the exact ray meets it (the rounding argument is at [`BoxRay`]), so a leaf
