@@ -286,7 +286,7 @@ struct Occluding<'a> {
 impl AnyLeaf for Occluding<'_> {
     #[inline(always)]
     fn leaf(&mut self, leaf: u32, count: u32) -> bool {
-        let lanes = self.vis.blocks.hits4(
+        let lanes = self.vis.blocks.lanes4(
             self.wt,
             leaf as usize,
             count as usize,
@@ -316,7 +316,7 @@ struct Closest<'a> {
 impl ClosestLeaf for Closest<'_> {
     #[inline(always)]
     fn leaf(&mut self, leaf: u32, count: u32, mut tmax: f32) -> f32 {
-        let ((t, lane), lanes) = self.vis.blocks.nearest4(
+        let lanes = self.vis.blocks.lanes4(
             self.wt,
             leaf as usize,
             count as usize,
@@ -324,6 +324,7 @@ impl ClosestLeaf for Closest<'_> {
             self.vis.epsilon,
         );
         if lanes.near == 0 {
+            let (t, lane) = lanes.nearest;
             // Every hit lies beyond the epsilon and counts ([`Visibility::counts`]); distances
             // are at most `tmax`, so the nearest lane wins unless it ties a lower slot.
             let s = 4 * leaf + lane;

@@ -260,11 +260,11 @@ impl TriangleBlocks {
         unsafe { _mm_loadu_ps(lanes.as_ptr()) }
     }
 
-    /// [`TriangleBlocks::intersect4`]'s distances with two masks computed in the vector
-    /// registers: the lanes hit, and those hit less than `epsilon` past `tmin` (`t − tmin <
-    /// epsilon`, in f32), which need a second look.
+    /// [`TriangleBlocks::intersect4`]'s distances read in the vector registers: the lanes hit,
+    /// those hit less than `epsilon` past `tmin` (`t − tmin < epsilon`, in f32), which need a
+    /// second look, and the nearest lane.
     #[inline(always)]
-    pub fn hits4(
+    pub fn lanes4(
         &self,
         wt: &Watertight,
         block: usize,
@@ -272,34 +272,6 @@ impl TriangleBlocks {
         (tmin, tmax): (f32, f32),
         epsilon: f32,
     ) -> Lanes4 {
-        self.nearest4_with(wt, block, count, (tmin, tmax), epsilon, false)
-            .1
-    }
-
-    /// [`TriangleBlocks::hits4`] and the nearest lane: the smallest distance (infinity when every
-    /// lane missed) and its lowest lane.
-    #[inline(always)]
-    pub fn nearest4(
-        &self,
-        wt: &Watertight,
-        block: usize,
-        count: usize,
-        (tmin, tmax): (f32, f32),
-        epsilon: f32,
-    ) -> ((f32, u32), Lanes4) {
-        self.nearest4_with(wt, block, count, (tmin, tmax), epsilon, true)
-    }
-
-    #[inline(always)]
-    fn nearest4_with(
-        &self,
-        wt: &Watertight,
-        block: usize,
-        count: usize,
-        (tmin, tmax): (f32, f32),
-        epsilon: f32,
-        nearest: bool,
-    ) -> ((f32, u32), Lanes4) {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: SSE2 is part of x86_64.
         unsafe {
@@ -308,37 +280,33 @@ impl TriangleBlocks {
             let mut ts = [0.0f32; 4];
             _mm_storeu_ps(ts.as_mut_ptr(), t);
             let near = _mm_cmplt_ps(_mm_sub_ps(t, _mm_set1_ps(tmin)), _mm_set1_ps(epsilon));
-            let lanes = Lanes4 {
-                hit: _mm_movemask_ps(_mm_cmplt_ps(t, _mm_set1_ps(f32::INFINITY))) as u32,
-                near: _mm_movemask_ps(near) as u32,
-                ts,
-            };
-            if !nearest {
-                return ((f32::INFINITY, 0), lanes);
-            }
             let m = _mm_min_ps(t, _mm_shuffle_ps::<0b01_00_11_10>(t, t));
             let m = _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m));
             // Some lane equals the minimum (no NaN arises), so the mask is not empty.
             let lane = (_mm_movemask_ps(_mm_cmpeq_ps(t, m)) as u32).trailing_zeros();
-            ((_mm_cvtss_f32(m), lane), lanes)
+            Lanes4 {
+                hit: _mm_movemask_ps(_mm_cmplt_ps(t, _mm_set1_ps(f32::INFINITY))) as u32,
+                near: _mm_movemask_ps(near) as u32,
+                nearest: (_mm_cvtss_f32(m), lane),
+                ts,
+            }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
             let ts = self.intersect4(wt, block, count, tmin, tmax);
             let mask = |f: &dyn Fn(f32) -> bool| (0..4).fold(0, |m, k| m | (f(ts[k]) as u32) << k);
-            let lanes = Lanes4 {
+            let t = ts.iter().fold(f32::INFINITY, |a, &b| a.min(b));
+            Lanes4 {
                 hit: mask(&|t| t < f32::INFINITY),
                 near: mask(&|t| t - tmin < epsilon),
+                nearest: (t, ts.iter().position(|&x| x == t).unwrap_or(0) as u32),
                 ts,
-            };
-            let t = ts.iter().fold(f32::INFINITY, |a, &b| a.min(b));
-            let lane = ts.iter().position(|&x| x == t).unwrap_or(0) as u32;
-            ((t, lane), lanes)
+            }
         }
     }
 }
 
-/// [`TriangleBlocks::hits4`]'s lanes.
+/// What [`TriangleBlocks::lanes4`] reads from a block's four distances.
 pub struct Lanes4 {
     /// Every lane's distance (infinity for a miss).
     pub ts: [f32; 4],
@@ -346,6 +314,8 @@ pub struct Lanes4 {
     pub hit: u32,
     /// Lanes hit less than the epsilon past `tmin` (a subset of `hit`).
     pub near: u32,
+    /// The smallest distance (infinity when every lane missed) and its lowest lane.
+    pub nearest: (f32, u32),
 }
 
 /// `mask ? a : b` lane-wise with SSE2 only.
