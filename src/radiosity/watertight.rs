@@ -342,9 +342,9 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    /// The paper's set-up as written (Woop, Benthin and Wald 2013, fig. 4): kz the largest
-    /// dimension of |d| (the first on ties), kx and ky the next two cyclically, swapped when
-    /// d[kz] < 0.
+    /// The paper's set-up as written out with branches (Woop, Benthin and Wald 2013): kz the
+    /// largest dimension of |d| (the first on ties, as relume always chose), kx and ky the next
+    /// two cyclically, swapped when d[kz] < 0.
     fn paper(d: [f32; 3]) -> ([usize; 3], [f32; 3]) {
         let a = d.map(f32::abs);
         let kz = if a[0] >= a[1] && a[0] >= a[2] {
