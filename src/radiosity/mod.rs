@@ -36,6 +36,7 @@ pub mod voxelize;
 pub mod watertight;
 pub mod wide_bvh;
 pub mod wide_collapse;
+pub mod wide_node;
 
 pub use matrix::TransportMatrix;
 use serde::{Deserialize, Serialize};

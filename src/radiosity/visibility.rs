@@ -11,8 +11,9 @@
 
 use super::geometry::Frame;
 use super::watertight::{TriangleBlocks, Watertight};
-use super::wide_bvh::{AnyLeaf, BoxRay, ClosestLeaf, WideBvh};
+use super::wide_bvh::{AnyLeaf, ClosestLeaf, WideBvh};
 use super::wide_collapse;
+use super::wide_node::BoxRay;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
