@@ -11,7 +11,7 @@ use glam::Vec3A;
 /// a[ky] + a[kz]·(−sy), a[kz]·sz)` with `sz = 1/d[kz]`, `sx = d[kx]·sz`, `sy = d[ky]·sz` (one
 /// division; watertightness needs only that every vertex of a ray's triangles is sheared the
 /// same way), with no FMA contraction (Rust has none), here and in every SSE lane of
-/// [`TriangleBlocks::intersect4`].
+/// [`TriangleBlocks::lanes4`].
 pub struct Watertight {
     origin: Vec3A,
     /// The permuted axes (kx, ky, kz) and the shear (−sx, −sy, sz).
@@ -127,9 +127,10 @@ impl TriangleBlocks {
     }
 
     /// The distances of [`Watertight::intersect`] to the first `count` triangles of block
-    /// `block` (lanes `count..` hold infinity).
-    #[inline(always)]
-    pub fn intersect4(
+    /// `block` (lanes `count..` hold infinity), one lane at a time: what
+    /// [`TriangleBlocks::lanes4`] computes in SSE lanes on x86_64.
+    #[cfg(not(target_arch = "x86_64"))]
+    fn intersect4(
         &self,
         wt: &Watertight,
         block: usize,
@@ -137,26 +138,13 @@ impl TriangleBlocks {
         tmin: f32,
         tmax: f32,
     ) -> [f32; 4] {
-        #[cfg(target_arch = "x86_64")]
-        {
-            let mut out = [0.0f32; 4];
-            // SAFETY: SSE2 is part of x86_64; `out` holds four f32.
-            unsafe {
-                let t = self.intersect4_sse(wt, block, count, tmin, tmax);
-                std::arch::x86_64::_mm_storeu_ps(out.as_mut_ptr(), t);
+        std::array::from_fn(|k| {
+            if k < count {
+                wt.intersect(&self.triangle(block, k), tmin, tmax)
+            } else {
+                f32::INFINITY
             }
-            out
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            std::array::from_fn(|k| {
-                if k < count {
-                    wt.intersect(&self.triangle(block, k), tmin, tmax)
-                } else {
-                    f32::INFINITY
-                }
-            })
-        }
+        })
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -267,7 +255,8 @@ impl TriangleBlocks {
         unsafe { _mm_loadu_ps(lanes.as_ptr()) }
     }
 
-    /// [`TriangleBlocks::intersect4`]'s distances read in the vector registers: the lanes hit,
+    /// The distances of [`Watertight::intersect`] to the first `count` triangles of block `block`
+    /// (lanes `count..` hold infinity), read in the vector registers: the lanes hit,
     /// those hit less than `epsilon` past `tmin` (`t − tmin < epsilon`, in f32), which need a
     /// second look, and the nearest lane.
     #[inline(always)]
