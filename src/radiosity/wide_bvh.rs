@@ -22,6 +22,7 @@ use super::wide_collapse::{Child, MAX_LEAF};
 #[cfg(target_arch = "x86_64")]
 use super::wide_node::node_hits_avx2;
 use super::wide_node::{node_hits_portable, BoxRay, Node, EMPTY, LEAF};
+use obvhs::aabb::Aabb;
 
 /// The tree. Leaf tests get a leaf's number; [`WideBvh::leaves`] maps it to its primitives.
 pub struct WideBvh {
@@ -77,8 +78,8 @@ impl WideBvh {
             leaves: Vec::new(),
             order: Vec::new(),
         };
-        let (lo, hi) = tree.node(0);
-        let largest = lo.iter().chain(&hi).fold(0.0f32, |m, x| m.max(x.abs()));
+        let whole = tree.node(0);
+        let largest = whole.min.abs().max(whole.max.abs()).max_element();
         let bvh = WideBvh {
             nodes: tree.nodes,
             leaves: tree.leaves,
@@ -322,9 +323,9 @@ struct Refit<'a, F> {
 
 impl<F: Fn(u32) -> ([f32; 3], [f32; 3])> Refit<'_, F> {
     /// Fill `nodes[index]` from the collapsed node of the same index and return its exact box.
-    fn node(&mut self, index: usize) -> ([f32; 3], [f32; 3]) {
+    fn node(&mut self, index: usize) -> Aabb {
         let src = self.src;
-        let mut whole = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        let mut whole = Aabb::INVALID;
         assert!(src[index].len() <= 8, "a node has at most eight children");
         let mut slots = Vec::with_capacity(8);
         for child in src[index].iter() {
@@ -335,9 +336,10 @@ impl<F: Fn(u32) -> ([f32; 3], [f32; 3])> Refit<'_, F> {
                         (1..=MAX_LEAF as usize).contains(&prims.len()),
                         "a leaf holds 1 to {MAX_LEAF} primitives"
                     );
-                    let mut b = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+                    let mut b = Aabb::INVALID;
                     for &p in prims {
-                        b = union(b, (self.prim_box)(p));
+                        let (lo, hi) = (self.prim_box)(p);
+                        b = b.union(&Aabb::new(lo.into(), hi.into()));
                     }
                     let id = self.leaves.len() as u32;
                     assert!(id < 1 << 28, "more leaves than a reference can address");
@@ -347,34 +349,22 @@ impl<F: Fn(u32) -> ([f32; 3], [f32; 3])> Refit<'_, F> {
                     (LEAF | id << 3 | prims.len() as u32, b)
                 }
             };
-            slots.push((half_area(b), b, reference));
-            whole = union(whole, b);
+            slots.push((b.half_area(), b, reference));
+            whole = whole.union(&b);
         }
         // Largest box first: see the occlusion traversal in [`WideBvh::any`].
         slots.sort_by(|a, b| b.0.total_cmp(&a.0));
         for (slot, (_, b, reference)) in slots.into_iter().enumerate() {
-            self.nodes[index].set(slot, b, reference);
+            self.nodes[index].set(slot, (b.min.to_array(), b.max.to_array()), reference);
         }
         whole
     }
 }
 
-/// Half the surface area of the box `lo..hi`.
-fn half_area((lo, hi): ([f32; 3], [f32; 3])) -> f32 {
-    let e: [f32; 3] = std::array::from_fn(|k| hi[k] - lo[k]);
-    e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
-}
-
-fn union(a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])) -> ([f32; 3], [f32; 3]) {
-    (
-        std::array::from_fn(|k| a.0[k].min(b.0[k])),
-        std::array::from_fn(|k| a.1[k].max(b.1[k])),
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3A;
     use proptest::prelude::*;
 
     proptest! {
@@ -409,10 +399,10 @@ mod tests {
                 let used: Vec<_> = (0..8).filter(|&k| node.child[k] != EMPTY).collect();
                 let area: Vec<f32> = used
                     .iter()
-                    .map(|&k| half_area((
-                        std::array::from_fn(|a| node.planes[a][k]),
-                        std::array::from_fn(|a| node.planes[3 + a][k]),
-                    )))
+                    .map(|&k| {
+                        let corner = |r: usize| Vec3A::from_array(std::array::from_fn(|a| node.planes[r + a][k]));
+                        Aabb::new(corner(0), corner(3)).half_area()
+                    })
                     .collect();
                 prop_assert!(area.windows(2).all(|w| w[0] >= w[1]), "slots out of order: {:?}", area);
                 prop_assert_eq!(used.len(), used.last().map_or(0, |&k| k + 1), "slots not packed");
