@@ -11,8 +11,8 @@
 //! **Precondition:** a direction (a, b) with |b| ≥ |a| (b ≠ 0), as for the f64 bundles;
 //! [`super::horizon_sweep::Sweeper`] transposes the map for the others.
 
-use super::horizon::encode;
 use super::horizon::{border_walk, bundle_list};
+use super::horizon::{encode, STEP_DEG};
 use super::horizon::{period, Direction, Stencil, Stencils};
 use super::horizon_hull::LANES;
 use super::horizon_hull_f32::{HullsF32, LaneInput, Step};
@@ -235,11 +235,20 @@ fn bundle_lanes(
             shift: (2.0 * kappa * tau) as f32,
         };
         let slopes = sc.hulls.step(&step, &input, plan.avx2);
-        let q = quantise(&slopes, inv_m);
+        let q = quantise_lanes(&slopes, inv_m, plan.avx2);
         let first = r * w + c0;
-        for j in 0..LANES {
-            if input.on[j] != 0 {
-                out[(first + j as i64) as usize].store(q[j], Ordering::Relaxed);
+        if all_fit {
+            // Every lane's pixel is on the map: one store of the eight texels, which no
+            // other lane or worker writes (the pixels of a bundle are its own).
+            let to = &out[first as usize..first as usize + LANES];
+            // SAFETY: eight consecutive texels of `out`, written by this lane alone and read
+            // by no one until the sweep returns (an AtomicU16 has u16's layout).
+            unsafe { std::ptr::copy_nonoverlapping(q.as_ptr(), to[0].as_ptr(), LANES) };
+        } else {
+            for j in 0..LANES {
+                if input.on[j] != 0 {
+                    out[(first + j as i64) as usize].store(q[j], Ordering::Relaxed);
+                }
             }
         }
     }
@@ -337,9 +346,9 @@ unsafe fn eval_avx2(
 }
 
 /// Slopes (t units) to the horizon map's u16: atan of slope/metres_per_t in degrees
-/// ([`atan_f32`]), then [`encode`]'s step (in f64: flat ground's 0° is the exact half step
-/// 32767.5, rounded up as the f64 sweep's map rounds it). Inlined into the bundle's walk, which
-/// is compiled for AVX2 where detected.
+/// ([`atan_f32`]), then [`encode`]'s step in f64, as the f64 sweep's map is quantised (flat
+/// ground's 0° is 90/STEP_DEG = 32767.499999999996 steps in f64, so 32767 in both). The
+/// portable twin of [`quantise_avx2`].
 #[inline(always)]
 fn quantise(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
     let mut out = [0u16; LANES];
@@ -347,6 +356,79 @@ fn quantise(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
         let deg = atan_f32(s * inv_m) * (180.0 / std::f32::consts::PI);
         *o = encode(deg as f64);
     }
+    out
+}
+
+/// [`quantise`] of eight lanes, in AVX2 where `avx2` (detected): the same operations, the
+/// same bits (a proptest).
+#[inline(always)]
+fn quantise_lanes(slopes: &[f32; LANES], inv_m: f32, avx2: bool) -> [u16; LANES] {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: AVX2 was detected.
+        return unsafe { quantise_avx2(slopes, inv_m) };
+    }
+    let _ = avx2;
+    quantise(slopes, inv_m)
+}
+
+/// [`quantise`] on eight lanes: [`atan_f32`]'s selects as blends, then [`encode`] in two
+/// halves of four f64 lanes. A NaN slope gives 0 as `encode` does (`max` returns its second
+/// operand, −90°, for a NaN first one).
+///
+/// # Safety
+/// AVX2 must be available.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+#[allow(clippy::excessive_precision)] // Cephes' constants as published
+unsafe fn quantise_avx2(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
+    use std::arch::x86_64::*;
+    let f = _mm256_set1_ps;
+    let v = _mm256_mul_ps(_mm256_loadu_ps(slopes.as_ptr()), f(inv_m));
+    let sign = _mm256_and_ps(v, f(-0.0));
+    let a = _mm256_andnot_ps(f(-0.0), v);
+    let big = _mm256_cmp_ps::<_CMP_GT_OQ>(a, f(2.414_213_562_373_095));
+    let mid = _mm256_cmp_ps::<_CMP_GT_OQ>(a, f(0.414_213_562_373_095_0));
+    let r_big = _mm256_div_ps(f(-1.0), a);
+    let r_mid = _mm256_div_ps(_mm256_sub_ps(a, f(1.0)), _mm256_add_ps(a, f(1.0)));
+    let r = _mm256_blendv_ps(_mm256_blendv_ps(a, r_mid, mid), r_big, big);
+    let base = _mm256_blendv_ps(
+        _mm256_blendv_ps(f(0.0), f(std::f32::consts::FRAC_PI_4), mid),
+        f(std::f32::consts::FRAC_PI_2),
+        big,
+    );
+    let z = _mm256_mul_ps(r, r);
+    let mut p = _mm256_sub_ps(
+        _mm256_mul_ps(f(8.053_744_495_38e-2), z),
+        f(1.387_768_560_32e-1),
+    );
+    p = _mm256_add_ps(_mm256_mul_ps(p, z), f(1.997_771_064_78e-1));
+    p = _mm256_sub_ps(_mm256_mul_ps(p, z), f(3.333_294_915_39e-1));
+    p = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(p, z), r), r);
+    let atan = _mm256_or_ps(_mm256_andnot_ps(f(-0.0), _mm256_add_ps(base, p)), sign);
+    let deg = _mm256_mul_ps(atan, f(180.0 / std::f32::consts::PI));
+    let half = |d: __m128| {
+        let d = _mm256_max_pd(_mm256_cvtps_pd(d), _mm256_set1_pd(-90.0));
+        let d = _mm256_min_pd(d, _mm256_set1_pd(90.0));
+        let x = _mm256_div_pd(
+            _mm256_add_pd(d, _mm256_set1_pd(90.0)),
+            _mm256_set1_pd(STEP_DEG),
+        );
+        let whole = _mm256_cvttpd_epi32(x);
+        let frac = _mm256_sub_pd(x, _mm256_cvtepi32_pd(whole));
+        let up = _mm256_cmp_pd::<_CMP_GE_OQ>(frac, _mm256_set1_pd(0.5));
+        // The all-ones mask of four lanes, packed to i32, is −1: subtracting it adds one.
+        let up = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(
+            _mm256_castpd_si256(up),
+            _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6),
+        ));
+        _mm_sub_epi32(whole, up)
+    };
+    let lo = half(_mm256_castps256_ps128(deg));
+    let hi = half(_mm256_extractf128_ps::<1>(deg));
+    let mut out = [0u16; LANES];
+    _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, _mm_packus_epi32(lo, hi));
     out
 }
 
@@ -421,6 +503,43 @@ mod tests {
             prop_assert!(slow.iter().all(|&v| v != u16::MAX), "a texel was not written");
             let same = fast.iter().zip(&slow).filter(|(a, b)| a == b).count();
             prop_assert_eq!(same, w * h, "{}x{} {:?}", w, h, d);
+        }
+    }
+
+    /// Slopes of every magnitude and the edge cases: ±0, ±∞, NaN, atan's break points and
+    /// the slopes whose angle lies on a quantisation step's midpoint (flat ground's 0°).
+    fn any_slope() -> impl Strategy<Value = f32> {
+        prop_oneof![
+            any::<f32>(),
+            (-1e3f32..1e3),
+            (-2.5f32..2.5),
+            prop::sample::select(vec![
+                0.0f32,
+                -0.0,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::NAN,
+                0.414_213_57,
+                -2.414_213_6,
+                1.0,
+                f32::MIN_POSITIVE,
+                f32::MAX,
+            ]),
+        ]
+    }
+
+    proptest! {
+        /// The AVX2 quantisation gives the portable one's u16 on every lane.
+        #[test]
+        fn avx2_quantise_equals_the_portable_one(
+            slopes in prop::array::uniform8(any_slope()),
+            inv_m in prop_oneof![Just(1.0f32), Just(1.0 / 40.0), 1e-4f32..1e2],
+        ) {
+            if !crate::cpu::has_avx2() {
+                prop_assert!(std::env::var_os("CI").is_none(), "no AVX2 on this CI machine");
+                return Ok(());
+            }
+            prop_assert_eq!(quantise_lanes(&slopes, inv_m, true), quantise(&slopes, inv_m));
         }
     }
 
