@@ -393,7 +393,19 @@ impl HullsF32 {
         let has_at = |i: usize| _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
         // The right neighbour of the sample pushed last (nearest P′ first): P′ itself.
         let (mut xr, mut yr, mut has_r) = (dx_next, f_next, prev_on);
-        for i in (0..k).rev() {
+        // No lane pushes a sample before its period's tangent point (`from` below): the loop
+        // stops at the first of those over the active lanes (k where none is active).
+        let mut first_from = [0i32; LANES];
+        _mm256_storeu_si256(
+            first_from.as_mut_ptr() as *mut __m256i,
+            _mm256_blendv_epi8(
+                _mm256_set1_epi32(k as i32),
+                argmax,
+                _mm256_and_si256(active, on),
+            ),
+        );
+        let lo = first_from.iter().copied().min().unwrap_or(0) as usize;
+        for i in (lo..k).rev() {
             let xi = *s.xs.get_unchecked(i);
             let (y, dxi) = (y_at(i), dx_at(i));
             let dxv = _mm256_set1_ps(dxi);
