@@ -256,7 +256,11 @@ fn bundle_lanes(
 
 /// A stencil's bilinear sample in f32 ([`Stencil::eval`]'s operations) relative to the
 /// pixel's height z: the taps less z first, so that a sample near the pixel keeps the
-/// precision of its height difference, not of the heights.
+/// precision of its height difference, not of the heights. Unlike the f64 `eval`, no clamp
+/// to the taps' range: the blend is a convex combination, which f32 rounding can carry past
+/// the range by an ulp of the height difference at most, far below the error budget; the
+/// clamp's eight operations were 2–3 % of a horizon build, and on Puget Sound 1024² (64
+/// directions) no quantised angle changed without them.
 #[inline]
 fn eval_f32(st: &Stencil, hs: &[f32], pixel: usize, w: usize, z: f32) -> f32 {
     let i = (pixel as isize + st.dy as isize * w as isize + st.dx as isize) as usize;
@@ -264,8 +268,7 @@ fn eval_f32(st: &Stencil, hs: &[f32], pixel: usize, w: usize, z: f32) -> f32 {
     let (tx, ty) = (st.tx as f32, st.ty as f32);
     let top = a + (b - a) * tx;
     let bottom = c + (d - c) * tx;
-    let v = top + (bottom - top) * ty;
-    v.max(a.min(b).min(c.min(d))).min(a.max(b).max(c.max(d)))
+    top + (bottom - top) * ty
 }
 
 /// Every stencil of the lanes' pixels `base + j` (all taps on the map), relative to their
@@ -340,9 +343,7 @@ unsafe fn eval_avx2(
     let top = _mm256_add_ps(a, _mm256_mul_ps(_mm256_sub_ps(b, a), tx));
     let bottom = _mm256_add_ps(c, _mm256_mul_ps(_mm256_sub_ps(d, c), tx));
     let v = _mm256_add_ps(top, _mm256_mul_ps(_mm256_sub_ps(bottom, top), ty));
-    let lo = _mm256_min_ps(_mm256_min_ps(a, b), _mm256_min_ps(c, d));
-    let hi = _mm256_max_ps(_mm256_max_ps(a, b), _mm256_max_ps(c, d));
-    _mm256_storeu_ps(out.as_mut_ptr(), _mm256_min_ps(_mm256_max_ps(v, lo), hi));
+    _mm256_storeu_ps(out.as_mut_ptr(), v);
 }
 
 /// Slopes (t units) to the horizon map's u16: atan of slope/metres_per_t in degrees
