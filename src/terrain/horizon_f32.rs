@@ -215,6 +215,9 @@ fn bundle_lanes(
                     for (s, &(_, hq)) in sc.border.iter().rev().enumerate() {
                         sc.heights[s][j] = (hq - z as f64) as f32;
                     }
+                    for row in &mut sc.heights[sc.border.len()..] {
+                        row[j] = f32::NEG_INFINITY;
+                    }
                     input.own[j] = (own.1 - z as f64) as f32;
                     input.count[j] = sc.border.len() as i32;
                 }

@@ -67,7 +67,8 @@ pub(super) struct Step<'a> {
 /// What each lane brings to a step.
 pub(super) struct LaneInput<'a> {
     /// The period samples' heights less P's, [s][lane]; a lane has its first `count[lane]`
-    /// (near the map's edge, the walk's samples stop there).
+    /// (near the map's edge, the walk's samples stop there), and −∞ after them where its
+    /// pixel is on the map.
     pub heights: &'a [[f32; LANES]],
     pub count: [i32; LANES],
     /// The own texel's half transit (less P's height) and P's height.
@@ -269,8 +270,10 @@ impl HullsF32 {
         );
         let mut best = _mm256_set1_ps(f32::NEG_INFINITY);
         let mut argmax = zero;
+        // A lane's samples past its count are −∞ (`LaneInput::heights`): they never reach
+        // `best`, nor move `argmax` once a sample has (where none has, `best` stays −∞ and the
+        // lane pushes nothing).
         for i in 0..s.xs.len() {
-            let has = _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
             let v = _mm256_mul_ps(
                 _mm256_sub_ps(
                     ld_f(l.heights.get_unchecked(i)),
@@ -278,17 +281,8 @@ impl HullsF32 {
                 ),
                 _mm256_set1_ps(*s.near_inv.get_unchecked(i)),
             );
-            let v = _mm256_blendv_ps(
-                _mm256_set1_ps(f32::NEG_INFINITY),
-                v,
-                _mm256_castsi256_ps(has),
-            );
             let ge = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(v, best));
-            argmax = _mm256_blendv_epi8(
-                argmax,
-                _mm256_set1_epi32(i as i32),
-                _mm256_and_si256(ge, has),
-            );
+            argmax = _mm256_blendv_epi8(argmax, _mm256_set1_epi32(i as i32), ge);
             best = _mm256_max_ps(best, v);
         }
         near = _mm256_max_ps(near, best);
