@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod freeform;
+pub mod study;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
