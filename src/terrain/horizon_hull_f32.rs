@@ -429,7 +429,7 @@ impl HullsF32 {
                 active,
                 _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), argmax),
             );
-            let m = _mm256_andnot_si256(skip, _mm256_and_si256(_mm256_and_si256(has, on), from));
+            let m = _mm256_and_si256(kept, _mm256_and_si256(on, from));
             if _mm256_testz_si256(m, m) == 0 {
                 push!(m, _mm256_set1_epi32(xi), y);
                 pushed = true;
