@@ -178,6 +178,7 @@ fn bundle_lanes(
                 *d = (kappa * (tau + t) * (tau + t)) as f32;
             }
         }
+        prefetch(plan, r - AHEAD * plan.dir.b, c0 - AHEAD * plan.dir.a);
         let rows_fit = r + st.lo[1] >= 0 && r + st.hi[1] < h;
         let all_fit = rows_fit && c0 + st.lo[0] >= 0 && c0 + LANES as i64 - 1 + st.hi[0] < w;
         let mut input = LaneInput {
@@ -255,6 +256,39 @@ fn bundle_lanes(
             }
         }
     }
+}
+
+/// How many steps ahead of the walk [`prefetch`] asks for the map's rows. On Puget Sound
+/// 4096² (64 directions) 1 to 8 steps all gain; 2 gained most, 7 % of the user time against
+/// prefetching the step being taken.
+const AHEAD: i64 = 2;
+
+/// Ask for the map's texels under the stencils of the step whose lane 0 is pixel (c0, r), when
+/// all of them are on the map: the walk crosses the map along its direction, b rows a step, so
+/// the hardware's prefetchers do not see its rows coming (at 4096², 64 directions, the
+/// stencils' loads took a third of the build's time without this).
+#[inline(always)]
+fn prefetch(plan: &Plan, r: i64, c0: i64) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let (st, map) = (&plan.stencils, plan.map);
+        let (w, h) = (map.width as i64, map.height as i64);
+        let (ca, cb) = (c0 + st.lo[0], c0 + LANES as i64 - 1 + st.hi[0]);
+        if r + st.lo[1] >= 0 && r + st.hi[1] < h && ca >= 0 && cb < w {
+            for y in r + st.lo[1]..=r + st.hi[1] {
+                let row = &map.heights[(y * w) as usize..][..w as usize];
+                for x in [ca, cb] {
+                    // SAFETY: SSE is part of x86-64; a prefetch of a texel on the map.
+                    unsafe {
+                        use std::arch::x86_64::*;
+                        _mm_prefetch::<_MM_HINT_T0>(row.as_ptr().add(x as usize) as *const i8);
+                    }
+                }
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (plan, r, c0);
 }
 
 /// A stencil's bilinear sample in f32 ([`Stencil::eval`]'s operations) relative to the

@@ -125,7 +125,9 @@ impl Sweeper<'_> {
             let map = HeightMap {
                 width: m.width,
                 height: m.height,
-                heights: m.heights.iter().map(|&h| h - mid).collect(),
+                heights: crate::cpu::huge_vec(m.heights.len(), |v| {
+                    v.extend(m.heights.iter().map(|&h| h - mid))
+                }),
                 cell_size: m.cell_size,
                 height_scale: m.height_scale,
             };
@@ -156,7 +158,9 @@ fn transposed(map: &HeightMap) -> HeightMap {
     HeightMap {
         width: map.height,
         height: map.width,
-        heights: transpose(&map.heights, map.width, map.height),
+        heights: crate::cpu::huge_vec(map.heights.len(), |v| {
+            v.extend(transpose(&map.heights, map.width, map.height))
+        }),
         cell_size: [map.cell_size[1], map.cell_size[0]],
         height_scale: map.height_scale,
     }
