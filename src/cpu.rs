@@ -35,21 +35,26 @@ pub fn has_avx2_fma() -> bool {
 /// a tenth of a 4096² build (docs/terrain.md).
 pub fn huge_vec<T: Copy>(n: usize, fill: impl FnOnce(&mut Vec<T>)) -> Vec<T> {
     let mut v: Vec<T> = Vec::with_capacity(n);
+    advise_huge(v.as_ptr() as usize, n * std::mem::size_of::<T>());
+    fill(&mut v);
+    v
+}
+
+/// `madvise(MADV_HUGEPAGE)` on the whole pages of [start, start + bytes).
+fn advise_huge(start: usize, bytes: usize) {
     #[cfg(target_os = "linux")]
     {
-        let bytes = n * std::mem::size_of::<T>();
-        let start = v.as_ptr() as usize;
         let page = 4096;
         let a = (start + page - 1) & !(page - 1);
         let b = (start + bytes) & !(page - 1);
         if b > a {
-            // SAFETY: advice on whole pages of this vector's own allocation; it changes no
+            // SAFETY: advice on whole pages of an allocation the caller owns; it changes no
             // contents, and failure (no THP in this kernel) is harmless.
             unsafe { libc::madvise(a as *mut libc::c_void, b - a, libc::MADV_HUGEPAGE) };
         }
     }
-    fill(&mut v);
-    v
+    #[cfg(not(target_os = "linux"))]
+    let _ = (start, bytes);
 }
 
 #[cfg(test)]
