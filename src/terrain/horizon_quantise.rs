@@ -1,0 +1,210 @@
+//! The horizon f32 sweep's quantisation ([`super::horizon_f32`]): each lane's slope to the
+//! horizon map's u16 step, through Cephes' `atanf` in f32 and [`encode`] in f64, eight lanes
+//! per AVX2 instruction with a portable twin that gives the same u16 (a proptest).
+
+use super::horizon::{encode, STEP_DEG};
+use super::horizon_hull::LANES;
+
+/// Slopes (t units) to the horizon map's u16: atan of slope/metres_per_t in degrees
+/// ([`atan_f32`]), then [`encode`]'s step in f64, as the f64 sweep's map is quantised (flat
+/// ground's 0° is 90/STEP_DEG = 32767.499999999996 steps in f64, so 32767 in both). The
+/// portable twin of [`quantise_avx2`].
+#[inline(always)]
+fn quantise(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
+    let mut out = [0u16; LANES];
+    for (o, &s) in out.iter_mut().zip(slopes) {
+        let deg = atan_f32(s * inv_m) * (180.0 / std::f32::consts::PI);
+        *o = encode(deg as f64);
+    }
+    out
+}
+
+/// [`quantise`] of eight lanes, in AVX2 where `avx2` (detected): the same operations, the
+/// same bits (a proptest).
+#[inline(always)]
+pub(super) fn quantise_lanes(slopes: &[f32; LANES], inv_m: f32, avx2: bool) -> [u16; LANES] {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: AVX2 was detected.
+        return unsafe { quantise_avx2(slopes, inv_m) };
+    }
+    let _ = avx2;
+    quantise(slopes, inv_m)
+}
+
+/// [`quantise`] on eight lanes: [`atan_f32`]'s selects as blends, then [`encode`] in two
+/// halves of four f64 lanes. A NaN slope gives 0 as `encode` does (`max` returns its second
+/// operand, −90°, for a NaN first one).
+///
+/// # Safety
+/// AVX2 must be available.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn quantise_avx2(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
+    use std::arch::x86_64::*;
+    let f = _mm256_set1_ps;
+    let v = _mm256_mul_ps(_mm256_loadu_ps(slopes.as_ptr()), f(inv_m));
+    let sign = _mm256_and_ps(v, f(-0.0));
+    let a = _mm256_andnot_ps(f(-0.0), v);
+    let big = _mm256_cmp_ps::<_CMP_GT_OQ>(a, f(TAN_3PI_8));
+    let mid = _mm256_cmp_ps::<_CMP_GT_OQ>(a, f(TAN_PI_8));
+    let r_big = _mm256_div_ps(f(-1.0), a);
+    let r_mid = _mm256_div_ps(_mm256_sub_ps(a, f(1.0)), _mm256_add_ps(a, f(1.0)));
+    let r = _mm256_blendv_ps(_mm256_blendv_ps(a, r_mid, mid), r_big, big);
+    let base = _mm256_blendv_ps(
+        _mm256_blendv_ps(f(0.0), f(std::f32::consts::FRAC_PI_4), mid),
+        f(std::f32::consts::FRAC_PI_2),
+        big,
+    );
+    let z = _mm256_mul_ps(r, r);
+    let [c0, c1, c2, c3] = ATAN_POLY;
+    let mut p = _mm256_sub_ps(_mm256_mul_ps(f(c0), z), f(c1));
+    p = _mm256_add_ps(_mm256_mul_ps(p, z), f(c2));
+    p = _mm256_sub_ps(_mm256_mul_ps(p, z), f(c3));
+    p = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(p, z), r), r);
+    let atan = _mm256_or_ps(_mm256_andnot_ps(f(-0.0), _mm256_add_ps(base, p)), sign);
+    let deg = _mm256_mul_ps(atan, f(180.0 / std::f32::consts::PI));
+    let half = |d: __m128| {
+        let d = _mm256_max_pd(_mm256_cvtps_pd(d), _mm256_set1_pd(-90.0));
+        let d = _mm256_min_pd(d, _mm256_set1_pd(90.0));
+        let x = _mm256_div_pd(
+            _mm256_add_pd(d, _mm256_set1_pd(90.0)),
+            _mm256_set1_pd(STEP_DEG),
+        );
+        let whole = _mm256_cvttpd_epi32(x);
+        let frac = _mm256_sub_pd(x, _mm256_cvtepi32_pd(whole));
+        let up = _mm256_cmp_pd::<_CMP_GE_OQ>(frac, _mm256_set1_pd(0.5));
+        // The all-ones mask of four lanes, packed to i32, is −1: subtracting it adds one.
+        let up = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(
+            _mm256_castpd_si256(up),
+            _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6),
+        ));
+        _mm_sub_epi32(whole, up)
+    };
+    let lo = half(_mm256_castps256_ps128(deg));
+    let hi = half(_mm256_extractf128_ps::<1>(deg));
+    let mut out = [0u16; LANES];
+    _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, _mm_packus_epi32(lo, hi));
+    out
+}
+
+/// Cephes' `atanf` reduction bounds, tan(3π/8) and tan(π/8), and its polynomial's magnitudes
+/// ((c₀z − c₁)z + c₂)z − c₃, shared by [`atan_f32`] and [`quantise_avx2`].
+#[allow(clippy::excessive_precision)] // Cephes' constants as published
+const TAN_3PI_8: f32 = 2.414_213_562_373_095;
+#[allow(clippy::excessive_precision)]
+const TAN_PI_8: f32 = 0.414_213_562_373_095_0;
+#[allow(clippy::excessive_precision)]
+const ATAN_POLY: [f32; 4] = [
+    8.053_744_495_38e-2,
+    1.387_768_560_32e-1,
+    1.997_771_064_78e-1,
+    3.333_294_915_39e-1,
+];
+
+/// atan(x) in f32: Cephes' `atanf` (S. L. Moshier; the argument reduced to |x| ≤ tan(π/8)
+/// by atan x = π/2 − atan(1/x) above tan(3π/8) and π/4 + atan((x − 1)/(x + 1)) between, then
+/// a polynomial of degree 4 in x²), written with selects so that eight lanes vectorise.
+/// Within 2 ulp of f64's atan (the unit test), about 1e-5° — far below the u16 step.
+#[inline(always)]
+pub(super) fn atan_f32(v: f32) -> f32 {
+    let a = v.abs();
+    let big = a > TAN_3PI_8;
+    let mid = a > TAN_PI_8;
+    let r_big = -1.0 / a;
+    let r_mid = (a - 1.0) / (a + 1.0);
+    let r = if big {
+        r_big
+    } else if mid {
+        r_mid
+    } else {
+        a
+    };
+    let base = if big {
+        std::f32::consts::FRAC_PI_2
+    } else if mid {
+        std::f32::consts::FRAC_PI_4
+    } else {
+        0.0
+    };
+    let z = r * r;
+    let [c0, c1, c2, c3] = ATAN_POLY;
+    let p = (((c0 * z - c1) * z + c2) * z - c3) * z * r + r;
+    (base + p).copysign(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Slopes of every magnitude and the edge cases: ±0 (flat ground's 0°, just under a
+    /// step's midpoint in f64), ±∞, NaN, the extremes of f32 and atan's break points.
+    fn any_slope() -> impl Strategy<Value = f32> {
+        prop_oneof![
+            any::<f32>(),
+            (-1e3f32..1e3),
+            (-2.5f32..2.5),
+            prop::sample::select(vec![
+                0.0f32,
+                -0.0,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::NAN,
+                0.414_213_57,
+                -2.414_213_6,
+                1.0,
+                f32::MIN_POSITIVE,
+                f32::MAX,
+            ]),
+        ]
+    }
+
+    proptest! {
+        /// The AVX2 quantisation gives the portable one's u16 on every lane.
+        #[test]
+        fn avx2_quantise_equals_the_portable_one(
+            slopes in prop::array::uniform8(any_slope()),
+            inv_m in prop_oneof![Just(1.0f32), Just(1.0 / 40.0), 1e-4f32..1e2],
+        ) {
+            if !crate::cpu::has_avx2() {
+                prop_assert!(std::env::var_os("CI").is_none(), "no AVX2 on this CI machine");
+                return Ok(());
+            }
+            prop_assert_eq!(quantise_lanes(&slopes, inv_m, true), quantise(&slopes, inv_m));
+        }
+    }
+
+    /// The f32 atan against f64's over every magnitude (with ±0, the break points and ±∞).
+    #[test]
+    fn atan_f32_matches_f64_within_two_ulp() {
+        let mut xs = vec![
+            0.0f32,
+            -0.0,
+            0.414_213_57,
+            2.414_213_6,
+            1.0,
+            f32::INFINITY,
+            -1e30,
+        ];
+        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..200_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let m = (s >> 40) as f32 / (1u64 << 24) as f32;
+            let e = ((s >> 3) % 60) as i32 - 30;
+            xs.push(if s & 1 == 0 { m } else { -m } * 2f32.powi(e));
+        }
+        let mut worst = 0.0f64;
+        for &v in &xs {
+            let want = (v as f64).atan();
+            let got = atan_f32(v) as f64;
+            let ulp = (want.abs() as f32).max(f32::MIN_POSITIVE) as f64 * f32::EPSILON as f64;
+            worst = worst.max((got - want).abs() / ulp);
+        }
+        // Measured: see the assertion's message when it fails.
+        assert!(worst <= 2.0, "worst {worst} ulp");
+    }
+}
