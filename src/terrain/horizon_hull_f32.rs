@@ -85,7 +85,7 @@ pub(super) struct LaneInput<'a> {
 pub(super) struct HullsF32 {
     // AVX2 layout: per slot and lane, the vertex below the one pushed there, as a record
     // [slot, y bits, x, x] of four i32 (`RECORD`); a slot's eight records in lane order
-    // 0, 4, 1, 5, 2, 6, 3, 7 (`record_at`).
+    // 0, 4, 1, 5, 2, 6, 3, 7 (`store_records`).
     below: Vec<i32>,
     slot: usize,
     top: [[i32; LANES]; 3],
@@ -292,7 +292,7 @@ impl HullsF32 {
         };
         let (mut v1, mut v2, mut v3) = (top(0), top(1), top(2));
         let below = self.below.as_mut_ptr();
-        // Each lane's record within a slot, in bytes (`record_at`).
+        // Each lane's record within a slot, in bytes (`store_records`).
         let within = _mm256_setr_epi32(0, 32, 64, 96, 16, 48, 80, 112);
         // Pop, in the lanes of mask m, while the top vertex fails the test against (xq, yq).
         macro_rules! pop_while {
