@@ -317,15 +317,9 @@ mod tests {
             f64::INFINITY,
             f64::NEG_INFINITY,
         ];
-        let mut s = 0x9E37_79B9_7F4A_7C15u64;
-        for _ in 0..200_000 {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            let m = (s >> 11) as f64 / (1u64 << 53) as f64;
-            let e = ((s >> 3) % 80) as i32 - 40;
-            xs.push(if s & 1 == 0 { m } else { -m } * 2f64.powi(e));
-        }
+        xs.extend(crate::terrain::horizon::test_maps::magnitudes(
+            200_000, 53, 40,
+        ));
         let mut worst = 0.0f64;
         for c in xs.chunks(LANES) {
             let mut x = [0.0; LANES];

@@ -188,15 +188,9 @@ mod tests {
             f32::INFINITY,
             -1e30,
         ];
-        let mut s = 0x9E37_79B9_7F4A_7C15u64;
-        for _ in 0..200_000 {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            let m = (s >> 40) as f32 / (1u64 << 24) as f32;
-            let e = ((s >> 3) % 60) as i32 - 30;
-            xs.push(if s & 1 == 0 { m } else { -m } * 2f32.powi(e));
-        }
+        // 24 bits of mantissa and |e| ≤ 30: every value is an f32.
+        let spread = crate::terrain::horizon::test_maps::magnitudes(200_000, 24, 30);
+        xs.extend(spread.into_iter().map(|v| v as f32));
         let mut worst = 0.0f64;
         for &v in &xs {
             let want = (v as f64).atan();
