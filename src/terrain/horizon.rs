@@ -428,22 +428,6 @@ pub(super) mod test_maps {
     use super::Direction;
     use crate::heightmap::HeightMap;
 
-    /// `n` pseudo-random values ±m·2^e of every magnitude for the `atan` tests: m with `bits`
-    /// bits of mantissa in [0, 1), e in [−half, half), the sign and both from one xorshift.
-    pub fn magnitudes(n: usize, bits: u32, half: i32) -> Vec<f64> {
-        let mut s = 0x9E37_79B9_7F4A_7C15u64;
-        (0..n)
-            .map(|_| {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                let m = (s >> (64 - bits)) as f64 / (1u64 << bits) as f64;
-                let e = ((s >> 3) % (2 * half as u64)) as i32 - half;
-                (if s & 1 == 0 { m } else { -m }) * 2f64.powi(e)
-            })
-            .collect()
-    }
-
     /// A rough random map (spikes over smooth noise) from a seed.
     pub fn map(w: usize, h: usize, seed: u64) -> HeightMap {
         let mut s = seed | 1;

@@ -299,6 +299,26 @@ fn atan_degrees_lanes(x: &[f64; LANES]) -> [f64; LANES] {
     out
 }
 
+/// Inputs for the `atan` tests of this module and of [`super::horizon_quantise`].
+#[cfg(test)]
+pub(super) mod test_values {
+    /// `n` pseudo-random values ±m·2^e of every magnitude for the `atan` tests: m with `bits`
+    /// bits of mantissa in [0, 1), e in [−half, half), the sign and both from one xorshift.
+    pub fn magnitudes(n: usize, bits: u32, half: i32) -> Vec<f64> {
+        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        (0..n)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                let m = (s >> (64 - bits)) as f64 / (1u64 << bits) as f64;
+                let e = ((s >> 3) % (2 * half as u64)) as i32 - half;
+                (if s & 1 == 0 { m } else { -m }) * 2f64.powi(e)
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -317,9 +337,7 @@ mod tests {
             f64::INFINITY,
             f64::NEG_INFINITY,
         ];
-        xs.extend(crate::terrain::horizon::test_maps::magnitudes(
-            200_000, 53, 40,
-        ));
+        xs.extend(test_values::magnitudes(200_000, 53, 40));
         let mut worst = 0.0f64;
         for c in xs.chunks(LANES) {
             let mut x = [0.0; LANES];

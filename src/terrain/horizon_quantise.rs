@@ -189,7 +189,7 @@ mod tests {
             -1e30,
         ];
         // 24 bits of mantissa and |e| ≤ 30: every value is an f32.
-        let spread = crate::terrain::horizon::test_maps::magnitudes(200_000, 24, 30);
+        let spread = crate::terrain::horizon_hull::test_values::magnitudes(200_000, 24, 30);
         xs.extend(spread.into_iter().map(|v| v as f32));
         let mut worst = 0.0f64;
         for &v in &xs {
