@@ -85,7 +85,8 @@ fn directions_are_near_uniform_and_distinct() {
         for (k, d) in dirs.iter().enumerate() {
             let target = k as f64 * 360.0 / n as f64;
             let err = relume::terrain::horizon::angle_between(d.azimuth_deg, target);
-            assert!(err <= 0.2 * 360.0 / n as f64 + 1e-9, "n {n} k {k}: {d:?}");
+            let tolerance = relume::terrain::horizon::AZIMUTH_TOLERANCE * 360.0 / n as f64;
+            assert!(err <= tolerance + 1e-9, "n {n} k {k}: {d:?}");
         }
         for w in dirs.windows(2) {
             assert!(w[0].azimuth_deg < w[1].azimuth_deg, "{:?}", w);

@@ -33,8 +33,8 @@
 //! (R + h)/R); the parabola — the usual GIS model, as in GRASS r.horizon — differs from it by a
 //! relative h/R of the slope: 0.0092° at worst on Big Tujunga on Earth (tests/terrain_horizon.rs).
 //!
-//! The azimuths are close to, not exactly, uniform: within a fifth of the spacing (the actual
-//! ones are stored with the map). The samples are bit for bit the walk's up to the rounding
+//! The azimuths are close to, not exactly, uniform: within 0.3 of the spacing (the actual ones
+//! are stored with the map, and the sky-view factor weights each by its gaps). The samples are bit for bit the walk's up to the rounding
 //! of the translated times (a few ulps), so the sweep agrees with [`horizon_exact`] to
 //! ~1e-9°.
 
@@ -86,11 +86,21 @@ impl Direction {
     }
 }
 
+/// How far, in spacings, a direction's azimuth may lie from its uniform target. The build's
+/// cost is the mean |a| + |b|: for 64 directions 9.06 at 0.2, 6.81 at 0.3 (the azimuths then up
+/// to 1.56° off, against 0.95°). On Puget Sound 2048² at 0.3 the build took 4.0–4.2 s against
+/// 4.9 s, and the O(1) shadows from the map differed from the exact mask on 0.144 % of the
+/// pixels against 0.192 %, over 108 suns (36 azimuths, elevations 3°, 8°, 20°): interpolating
+/// over uneven gaps cost nothing measurable (docs/terrain.md).
+pub const AZIMUTH_TOLERANCE: f64 = 0.3;
+
 /// N directions close to N uniform azimuths (k·360/N, k = 0..N): for each, the texel step
-/// (a, b) with the smallest |a| + |b| (the cost per pixel) whose azimuth is within a fifth of the
-/// spacing, searching |a|, |b| ≤ 64, a and b coprime and not both odd (except the diagonals).
-/// Deterministic; distinct for N ≤ 360.
+/// (a, b) with the smallest |a| + |b| (the cost per pixel) whose azimuth is within
+/// [`AZIMUTH_TOLERANCE`] of the spacing, searching |a|, |b| ≤ 64, a and b coprime and not both
+/// odd (except the diagonals). Deterministic; distinct and in the order of their targets (the
+/// tolerance is under half the spacing).
 pub fn directions(n: usize, cell_size: [f64; 2]) -> Vec<Direction> {
+    const { assert!(AZIMUTH_TOLERANCE < 0.5) };
     let spacing = 360.0 / n as f64;
     (0..n)
         .map(|k| {
@@ -111,7 +121,7 @@ pub fn directions(n: usize, cell_size: [f64; 2]) -> Vec<Direction> {
                     let err = angle_between(d.azimuth_deg, target);
                     let cost = a.abs() + b.abs();
                     // Within the tolerance: the cheapest, then the closest; else the closest.
-                    let ok = err <= 0.2 * spacing;
+                    let ok = err <= AZIMUTH_TOLERANCE * spacing;
                     let key = (!ok, if ok { cost } else { 0 }, err);
                     let better = match &best {
                         None => true,
