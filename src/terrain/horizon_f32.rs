@@ -13,7 +13,7 @@
 //! [`super::horizon_sweep::Sweeper`] transposes the map for the others.
 
 use super::horizon::{border_walk, bundle_list};
-use super::horizon::{period, Direction, Stencil, Stencils};
+use super::horizon::{period, Direction, Stencils};
 use super::horizon_hull::LANES;
 use super::horizon_hull_f32::{HullsF32, LaneInput, Step};
 use super::horizon_quantise::quantise_lanes;
@@ -57,10 +57,27 @@ struct Plan<'a> {
     near_inv: Vec<f32>,
     period_t: f64,
     kappa: f64,
-    /// Fixed-point units per t (2^F), and each period sample's t in them.
+    /// Fixed-point units per t (2^F), and each period sample's t in them (exact i32, and as
+    /// f32: a sample's τ less P's).
     units: f64,
     offsets: Vec<i32>,
+    offsets_f: Vec<f32>,
+    /// The stencils in f32 with their texel offsets from the pixel: the period's, then the own
+    /// half transit.
+    taps: Vec<Tap>,
+    /// The texel offsets from a step's lane-0 pixel of the two ends of each row its stencils
+    /// read, [`AHEAD`] steps further on ([`prefetch`]).
+    ahead: Vec<isize>,
     avx2: bool,
+}
+
+/// A stencil in f32 ([`eval_f32`]): its top-left tap's offset from the pixel in the map's
+/// row-major order, and its weights.
+#[derive(Clone, Copy)]
+struct Tap {
+    at: isize,
+    tx: f32,
+    ty: f32,
 }
 
 impl<'a> Plan<'a> {
@@ -91,9 +108,43 @@ impl<'a> Plan<'a> {
             units: 2f64.powi(bits as i32),
             avx2,
             offsets: Vec::new(),
+            offsets_f: Vec::new(),
+            taps: Vec::new(),
+            ahead: Vec::new(),
         };
         plan.offsets = plan.ts.iter().map(|&t| plan.fixed(t)).collect();
+        plan.offsets_f = plan.offsets.iter().map(|&o| o as f32).collect();
+        let w = map.width as isize;
+        let st = &plan.stencils;
+        plan.taps = st
+            .period
+            .iter()
+            .chain([&st.own])
+            .map(|s| Tap {
+                at: s.dy as isize * w + s.dx as isize,
+                tx: s.tx as f32,
+                ty: s.ty as f32,
+            })
+            .collect();
+        let back = AHEAD as isize * (dir.b as isize * w + dir.a as isize);
+        plan.ahead = (st.lo[1]..=st.hi[1])
+            .flat_map(|y| {
+                [st.lo[0], LANES as i64 - 1 + st.hi[0]].map(|x| y as isize * w + x as isize - back)
+            })
+            .collect();
         plan
+    }
+
+    /// The steps n of the bundle starting at (r₀, x₀) whose lanes' stencils all lie on the
+    /// map (empty when lo > hi): r = r₀ + n·b and c₀ = x₀ + n·a are linear in n, so the
+    /// conditions on the stencils' box hold on an interval.
+    fn fitting(&self, (r0, x0): (i64, i64)) -> (i64, i64) {
+        let (w, h) = (self.map.width as i64, self.map.height as i64);
+        let st = &self.stencils;
+        let (a, b) = (self.dir.a, self.dir.b);
+        let rows = steps_within(-st.lo[1] - r0, h - 1 - st.hi[1] - r0, b);
+        let cols = steps_within(-st.lo[0] - x0, w - LANES as i64 - st.hi[0] - x0, a);
+        (rows.0.max(cols.0), rows.1.min(cols.1))
     }
 
     /// τ ≥ 0 to the nearest fixed-point unit (halves up; no libm call).
@@ -102,11 +153,21 @@ impl<'a> Plan<'a> {
     }
 }
 
+/// The n with lo ≤ n·q ≤ hi, as an interval (empty when its start exceeds its end).
+fn steps_within(lo: i64, hi: i64, q: i64) -> (i64, i64) {
+    let ceil = |p: i64, q: i64| -(-p).div_euclid(q);
+    match q.signum() {
+        0 if lo <= 0 && 0 <= hi => (i64::MIN, i64::MAX),
+        0 => (1, 0),
+        1 => (ceil(lo, q), hi.div_euclid(q)),
+        _ => (ceil(-hi, -q), (-lo).div_euclid(-q)),
+    }
+}
+
 /// One worker's scratch.
 struct Scratch {
     hulls: HullsF32,
     heights: Vec<[f32; LANES]>,
-    xs: Vec<i32>,
     drop: Vec<f32>,
     border: Vec<(f64, f64)>,
 }
@@ -116,7 +177,6 @@ impl Scratch {
         Scratch {
             hulls: HullsF32::new(),
             heights: vec![[0.0; LANES]; samples],
-            xs: vec![0; samples],
             drop: vec![0.0; samples],
             border: Vec::new(),
         }
@@ -166,38 +226,39 @@ fn bundle_lanes(
     let k = plan.ts.len();
     sc.hulls.reset((n1 - n0 + 1) as usize * (k + 1));
     let inv_m = (1.0 / plan.track.metres_per_t) as f32;
+    let (fit0, fit1) = plan.fitting((r0, x0));
+    let mut input = LaneInput {
+        count: [k as i32; LANES],
+        own: [0.0; LANES],
+        zp: [0.0; LANES],
+        on: [-1; LANES],
+    };
+    let heights = &mut sc.heights;
     for n in (n0..=n1).rev() {
         let r = r0 + n * plan.dir.b;
         let c0 = x0 + n * plan.dir.a;
         let tau = n as f64 * plan.period_t;
         let xp = plan.fixed(tau);
-        for (x, &off) in sc.xs.iter_mut().zip(&plan.offsets) {
-            *x = xp + off;
-        }
         if kappa != 0.0 {
             for (d, &t) in sc.drop.iter_mut().zip(&plan.ts) {
                 *d = (kappa * (tau + t) * (tau + t)) as f32;
             }
         }
-        prefetch(plan, r - AHEAD * plan.dir.b, c0 - AHEAD * plan.dir.a);
-        let rows_fit = r + st.lo[1] >= 0 && r + st.hi[1] < h;
-        let all_fit = rows_fit && c0 + st.lo[0] >= 0 && c0 + LANES as i64 - 1 + st.hi[0] < w;
-        let mut input = LaneInput {
-            heights: &[],
-            count: [0; LANES],
-            own: [0.0; LANES],
-            zp: [0.0; LANES],
-            on: [0; LANES],
-        };
+        let base = r * w + c0;
+        if (fit0..=fit1).contains(&(n - AHEAD)) {
+            prefetch(plan, base);
+        }
+        let all_fit = (fit0..=fit1).contains(&n);
         if all_fit {
-            let base = (r * w + c0) as usize;
-            for (z, &v) in input.zp.iter_mut().zip(&hs[base..base + LANES]) {
-                *z = v;
-            }
-            eval_lanes(plan, base, &input.zp, &mut sc.heights, &mut input.own);
+            let base = base as usize;
+            input.zp.copy_from_slice(&hs[base..base + LANES]);
+            eval_lanes(plan, base, &input.zp, heights, &mut input.own);
             input.count = [k as i32; LANES];
             input.on = [-1; LANES];
         } else {
+            input.count = [0; LANES];
+            input.on = [0; LANES];
+            let rows_fit = r + st.lo[1] >= 0 && r + st.hi[1] < h;
             for j in 0..LANES {
                 let c = c0 + j as i64;
                 if c < 0 || c >= w {
@@ -208,16 +269,16 @@ fn bundle_lanes(
                 let z = hs[pixel];
                 input.zp[j] = z;
                 if rows_fit && c + st.lo[0] >= 0 && c + st.hi[0] < w {
-                    eval_lane(plan, pixel, z, j, &mut sc.heights, &mut input.own);
+                    eval_lane(plan, pixel, z, j, heights, &mut input.own);
                     input.count[j] = k as i32;
                 } else {
                     let dt = (&plan.dir, &plan.track);
                     let (own, _) = border_walk(map, dt, &plan.per, (c, r), &mut sc.border);
                     // The walk's samples in push order: reversed, they are the first ones.
                     for (s, &(_, hq)) in sc.border.iter().rev().enumerate() {
-                        sc.heights[s][j] = (hq - z as f64) as f32;
+                        heights[s][j] = (hq - z as f64) as f32;
                     }
-                    for row in &mut sc.heights[sc.border.len()..] {
+                    for row in &mut heights[sc.border.len()..] {
                         row[j] = f32::NEG_INFINITY;
                     }
                     input.own[j] = (own.1 - z as f64) as f32;
@@ -225,10 +286,10 @@ fn bundle_lanes(
                 }
             }
         }
-        input.heights = &sc.heights;
         let step = Step {
             xp,
-            xs: &sc.xs,
+            offsets: &plan.offsets,
+            offsets_f: &plan.offsets_f,
             drop: &sc.drop,
             drop_p: (kappa * tau * tau) as f32,
             near_drop: &plan.near_drop,
@@ -239,20 +300,20 @@ fn bundle_lanes(
             scale: plan.units as f32,
             shift: (2.0 * kappa * tau) as f32,
         };
-        let slopes = sc.hulls.step(&step, &input, plan.avx2);
+        let slopes = sc.hulls.step(&step, &input, heights, plan.avx2);
         let q = quantise_lanes(&slopes, inv_m, plan.avx2);
-        let first = r * w + c0;
+        let first = base as usize;
         if all_fit {
             // Every lane's pixel is on the map: one store of the eight texels, which no
             // other lane or worker writes (the pixels of a bundle are its own).
-            let to = &out[first as usize..first as usize + LANES];
+            let to = &out[first..first + LANES];
             // SAFETY: eight consecutive texels of `out`, written by this lane alone and read
             // by no one until the sweep returns (an AtomicU16 has u16's layout).
             unsafe { std::ptr::copy_nonoverlapping(q.as_ptr(), to[0].as_ptr(), LANES) };
         } else {
             for j in 0..LANES {
                 if input.on[j] != 0 {
-                    out[(first + j as i64) as usize].store(q[j], Ordering::Relaxed);
+                    out[(base + j as i64) as usize].store(q[j], Ordering::Relaxed);
                 }
             }
         }
@@ -264,32 +325,25 @@ fn bundle_lanes(
 /// prefetching the step being taken.
 const AHEAD: i64 = 2;
 
-/// Ask for the map's texels under the stencils of the step whose lane 0 is pixel (c0, r), when
-/// all of them are on the map: the walk crosses the map along its direction, b rows a step, so
-/// the hardware's prefetchers do not see its rows coming (at 4096², 64 directions, the
-/// stencils' loads took a third of the build's time without this).
+/// Ask for the map's texels under the stencils of the step [`AHEAD`] steps on from the one
+/// whose lane 0 is pixel `base` (row-major), when all of them are on the map (the caller's
+/// test): the walk crosses the map along its direction, b rows a step, so the hardware's
+/// prefetchers do not see its rows coming (at 4096², 64 directions, the stencils' loads took a
+/// third of the build's time without this).
 #[inline(always)]
-fn prefetch(plan: &Plan, r: i64, c0: i64) {
+fn prefetch(plan: &Plan, base: i64) {
     #[cfg(target_arch = "x86_64")]
-    {
-        let (st, map) = (&plan.stencils, plan.map);
-        let (w, h) = (map.width as i64, map.height as i64);
-        let (ca, cb) = (c0 + st.lo[0], c0 + LANES as i64 - 1 + st.hi[0]);
-        if r + st.lo[1] >= 0 && r + st.hi[1] < h && ca >= 0 && cb < w {
-            for y in r + st.lo[1]..=r + st.hi[1] {
-                let row = &map.heights[(y * w) as usize..][..w as usize];
-                for x in [ca, cb] {
-                    // SAFETY: SSE is part of x86-64; a prefetch of a texel on the map.
-                    unsafe {
-                        use std::arch::x86_64::*;
-                        _mm_prefetch::<_MM_HINT_T0>(row.as_ptr().add(x as usize) as *const i8);
-                    }
-                }
-            }
+    for &o in &plan.ahead {
+        // SAFETY: SSE is part of x86-64; a prefetch is only a hint, and `wrapping_offset`
+        // forms its address without dereferencing it (the caller's test keeps it on the map).
+        unsafe {
+            use std::arch::x86_64::*;
+            let p = plan.map.heights.as_ptr().wrapping_offset(base as isize + o);
+            _mm_prefetch::<_MM_HINT_T0>(p as *const i8);
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = (plan, r, c0);
+    let _ = (plan, base);
 }
 
 /// A stencil's bilinear sample in f32 ([`Stencil::eval`]'s operations) relative to the
@@ -300,10 +354,10 @@ fn prefetch(plan: &Plan, r: i64, c0: i64) {
 /// clamp's eight operations were 2–3 % of a horizon build, and on Puget Sound at 1024² and
 /// 4096² (64 directions) no quantised angle changed without them.
 #[inline]
-fn eval_f32(st: &Stencil, hs: &[f32], pixel: usize, w: usize, z: f32) -> f32 {
-    let i = (pixel as isize + st.dy as isize * w as isize + st.dx as isize) as usize;
+fn eval_f32(tap: &Tap, hs: &[f32], pixel: usize, w: usize, z: f32) -> f32 {
+    let i = (pixel as isize + tap.at) as usize;
     let (a, b, c, d) = (hs[i] - z, hs[i + 1] - z, hs[i + w] - z, hs[i + w + 1] - z);
-    let (tx, ty) = (st.tx as f32, st.ty as f32);
+    let (tx, ty) = (tap.tx, tap.ty);
     let top = a + (b - a) * tx;
     let bottom = c + (d - c) * tx;
     top + (bottom - top) * ty
@@ -319,15 +373,22 @@ fn eval_lanes(
     heights: &mut [[f32; LANES]],
     own: &mut [f32; LANES],
 ) {
-    let (hs, w, st) = (&plan.map.heights[..], plan.map.width, &plan.stencils);
+    let (hs, w) = (&plan.map.heights[..], plan.map.width);
+    let (period, last) = plan.taps.split_at(plan.taps.len() - 1);
     #[cfg(target_arch = "x86_64")]
     if plan.avx2 {
-        // SAFETY: AVX2 was detected; every tap of every lane is on the map (the caller's test).
+        // Every tap of every lane on the map (the caller's test), checked once for the box.
+        let st = &plan.stencils;
+        let lo = base as isize + st.lo[1] as isize * w as isize + st.lo[0] as isize;
+        let hi = base as isize + st.hi[1] as isize * w as isize + st.hi[0] as isize;
+        assert!(lo >= 0 && hi + LANES as isize <= hs.len() as isize);
+        // SAFETY: AVX2 was detected; every tap lies in the box just checked.
         unsafe {
-            for (s, stencil) in st.period.iter().enumerate() {
-                eval_avx2(stencil, hs, base, w, z, &mut heights[s]);
+            let p = hs.as_ptr().add(base);
+            for (tap, out) in period.iter().zip(heights.iter_mut()) {
+                eval_avx2(tap, p, w, z, out);
             }
-            eval_avx2(&st.own, hs, base, w, z, own);
+            eval_avx2(&last[0], p, w, z, own);
         }
         return;
     }
@@ -346,33 +407,25 @@ fn eval_lane(
     heights: &mut [[f32; LANES]],
     own: &mut [f32; LANES],
 ) {
-    let (hs, w, st) = (&plan.map.heights[..], plan.map.width, &plan.stencils);
-    for (s, stencil) in st.period.iter().enumerate() {
-        heights[s][j] = eval_f32(stencil, hs, pixel, w, z);
+    let (hs, w) = (&plan.map.heights[..], plan.map.width);
+    let (period, last) = plan.taps.split_at(plan.taps.len() - 1);
+    for (tap, row) in period.iter().zip(heights.iter_mut()) {
+        row[j] = eval_f32(tap, hs, pixel, w, z);
     }
-    own[j] = eval_f32(&st.own, hs, pixel, w, z);
+    own[j] = eval_f32(&last[0], hs, pixel, w, z);
 }
 
-/// [`eval_f32`] of lanes `base + j`, eight at a time: the same operations, the same bits.
+/// [`eval_f32`] of the eight lanes whose pixel 0 is at `p`: the same operations, the same bits.
 ///
 /// # Safety
-/// AVX2 must be available, and the taps of lanes 0..LANES must lie in `hs`.
+/// AVX2 must be available, and the taps of lanes 0..LANES must lie in the map `p` points into.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-unsafe fn eval_avx2(
-    st: &Stencil,
-    hs: &[f32],
-    base: usize,
-    w: usize,
-    z: &[f32; LANES],
-    out: &mut [f32; LANES],
-) {
+unsafe fn eval_avx2(tap: &Tap, p: *const f32, w: usize, z: &[f32; LANES], out: &mut [f32; LANES]) {
     use std::arch::x86_64::*;
-    let i = (base as isize + st.dy as isize * w as isize + st.dx as isize) as usize;
-    assert!(i + w + LANES < hs.len());
-    let (tx, ty) = (_mm256_set1_ps(st.tx as f32), _mm256_set1_ps(st.ty as f32));
-    let p = hs.as_ptr().add(i);
+    let (tx, ty) = (_mm256_set1_ps(tap.tx), _mm256_set1_ps(tap.ty));
+    let p = p.offset(tap.at);
     let z = _mm256_loadu_ps(z.as_ptr());
     let a = _mm256_sub_ps(_mm256_loadu_ps(p), z);
     let b = _mm256_sub_ps(_mm256_loadu_ps(p.add(1)), z);

@@ -50,9 +50,10 @@ use super::horizon_hull::LANES;
 /// What every lane of one pixel step shares (module notes; `s` indexes the period's samples,
 /// nearest first).
 pub(super) struct Step<'a> {
-    /// τ_P in fixed point, and each period sample's τ.
+    /// τ_P in fixed point, and each period sample's τ less τ_P (exact, and as f32).
     pub xp: i32,
-    pub xs: &'a [i32],
+    pub offsets: &'a [i32],
+    pub offsets_f: &'a [f32],
     /// κτ² of each sample (the drop on the line's parabola) and of P.
     pub drop: &'a [f32],
     pub drop_p: f32,
@@ -67,12 +68,11 @@ pub(super) struct Step<'a> {
     pub shift: f32,
 }
 
-/// What each lane brings to a step.
-pub(super) struct LaneInput<'a> {
-    /// The period samples' heights less P's, [s][lane]; a lane has its first `count[lane]`
-    /// (near the map's edge, the walk's samples stop there), and −∞ after them where its
-    /// pixel is on the map.
-    pub heights: &'a [[f32; LANES]],
+/// What each lane brings to a step, besides its samples' heights (`heights` in
+/// [`HullsF32::step`]: the period samples' heights less P's, [s][lane]; a lane has its first
+/// `count[lane]` (near the map's edge, the walk's samples stop there), and −∞ after them where
+/// its pixel is on the map).
+pub(super) struct LaneInput {
     pub count: [i32; LANES],
     /// The own texel's half transit (less P's height) and P's height.
     pub own: [f32; LANES],
@@ -140,21 +140,28 @@ impl HullsF32 {
     /// off the map). With `avx2` (detected by the caller) the AVX2 kernel, else the portable
     /// one: the same bits. A bundle must use one of them throughout.
     #[inline(always)]
-    pub fn step(&mut self, s: &Step, l: &LaneInput, avx2: bool) -> [f32; LANES] {
+    pub fn step(
+        &mut self,
+        s: &Step,
+        l: &LaneInput,
+        heights: &[[f32; LANES]],
+        avx2: bool,
+    ) -> [f32; LANES] {
         #[cfg(target_arch = "x86_64")]
         if avx2 {
-            assert!(self.below.len() >= (self.slot + s.xs.len() + 1) * LANES * RECORD);
-            assert!(l.heights.len() >= s.xs.len() && s.drop.len() >= s.xs.len());
-            assert!(s.near_drop.len() >= s.xs.len() && s.near_inv.len() >= s.xs.len());
-            assert!(l.count.iter().all(|&c| c >= 0 && c as usize <= s.xs.len()));
+            let k = s.offsets.len();
+            assert!(self.below.len() >= (self.slot + k + 1) * LANES * RECORD);
+            assert!(heights.len() >= k && s.drop.len() >= k && s.offsets_f.len() >= k);
+            assert!(s.near_drop.len() >= k && s.near_inv.len() >= k);
+            assert!(counts_within(&l.count, k));
             // SAFETY: AVX2 was detected; the asserts above give the slots and the lengths.
-            return unsafe { self.step_avx2(s, l) };
+            return unsafe { self.step_avx2(s, l, heights) };
         }
         let _ = avx2;
         let mut out = [0.0; LANES];
         for (j, o) in out.iter_mut().enumerate() {
             if l.on[j] != 0 {
-                *o = self.step_lane(s, l, j);
+                *o = self.step_lane(s, l, heights, j);
             }
         }
         self.f_prev = std::array::from_fn(|j| l.zp[j] - s.drop_p);
@@ -164,12 +171,12 @@ impl HullsF32 {
 
     /// Lane j's step (module notes, steps 1–4): the portable kernel.
     #[inline(always)]
-    fn step_lane(&mut self, s: &Step, l: &LaneInput, j: usize) -> f32 {
+    fn step_lane(&mut self, s: &Step, l: &LaneInput, heights: &[[f32; LANES]], j: usize) -> f32 {
         let (zp, count) = (l.zp[j], l.count[j] as usize);
         let mut near = (l.own[j] - s.own_drop) * s.own_inv;
         let (mut best, mut m) = (f32::NEG_INFINITY, 0usize);
         for i in 0..count {
-            let v = (l.heights[i][j] - s.near_drop[i]) * s.near_inv[i];
+            let v = (heights[i][j] - s.near_drop[i]) * s.near_inv[i];
             m = if v >= best { i } else { m };
             best = best.max(v);
         }
@@ -185,8 +192,8 @@ impl HullsF32 {
         };
         if best > far {
             let (prev_on, f_next) = (self.prev_on[j] != 0, self.f_prev[j]);
-            let y = |i: usize| l.heights[i][j] + (zp - s.drop[i]);
-            let dx = |i: usize| (s.xs[i] - s.xp) as f32;
+            let y = |i: usize| heights[i][j] + (zp - s.drop[i]);
+            let dx = |i: usize| s.offsets_f[i];
             // The right end: the last sample kept, P′ before any.
             let mut right = prev_on.then_some((s.dx_next, f_next));
             for i in (m..count).rev() {
@@ -204,14 +211,21 @@ impl HullsF32 {
                     }
                 }
                 right = Some((dx(i), yi));
-                st.pop_while(s.xs[i], yi);
-                st.push(s.xs[i], yi);
+                st.pop_while(s.xp + s.offsets[i], yi);
+                st.push(s.xp + s.offsets[i], yi);
             }
             st.pop_while(s.xp, fp);
         }
         st.push(s.xp, fp);
         near.max(far)
     }
+}
+
+/// Whether every lane's count lies in 0..=k (eight lanes in two compares where AVX2 is on).
+#[inline(always)]
+fn counts_within(count: &[i32; LANES], k: usize) -> bool {
+    let k = k as i32;
+    count.iter().fold(true, |ok, &c| ok & (c >= 0) & (c <= k))
 }
 
 /// A lane's hull in the portable kernel: a buffer sized by `reset`, with its length.
@@ -252,10 +266,15 @@ impl HullsF32 {
     /// order (no FMA).
     ///
     /// # Safety
-    /// AVX2 must be available; `below*` must have room for `xs.len() + 1` more slots, and the
-    /// slices of `s` and `l.heights` at least `xs.len()` entries, every count at most that.
+    /// AVX2 must be available; `below` must have room for k + 1 more slots, and the slices of
+    /// `s` and `heights` at least k entries (k = `s.offsets.len()`), every count at most k.
     #[target_feature(enable = "avx2")]
-    unsafe fn step_avx2(&mut self, s: &Step, l: &LaneInput) -> [f32; LANES] {
+    unsafe fn step_avx2(
+        &mut self,
+        s: &Step,
+        l: &LaneInput,
+        heights: &[[f32; LANES]],
+    ) -> [f32; LANES] {
         use std::arch::x86_64::*;
         let ld_i = |a: &[i32; LANES]| _mm256_loadu_si256(a.as_ptr() as *const __m256i);
         let ld_f = |a: &[f32; LANES]| _mm256_loadu_ps(a.as_ptr());
@@ -271,10 +290,10 @@ impl HullsF32 {
         // A lane's samples past its count are −∞ (`LaneInput::heights`): they never reach
         // `best`, nor move `argmax` once a sample has (where none has, `best` stays −∞ and the
         // lane pushes nothing).
-        for i in 0..s.xs.len() {
+        for i in 0..s.offsets.len() {
             let v = _mm256_mul_ps(
                 _mm256_sub_ps(
-                    ld_f(l.heights.get_unchecked(i)),
+                    ld_f(heights.get_unchecked(i)),
                     _mm256_set1_ps(*s.near_drop.get_unchecked(i)),
                 ),
                 _mm256_set1_ps(*s.near_inv.get_unchecked(i)),
@@ -362,17 +381,16 @@ impl HullsF32 {
         // 3. Where the period's largest slope beats the far one, its samples from m on that lie
         // above the chord from P to P′ (all of them where P′ is off) and their neighbours.
         let active = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(best, far));
-        let mut pushed = false;
         let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
         let dx_next = _mm256_set1_ps(s.dx_next);
-        let k = s.xs.len();
+        let k = s.offsets.len();
         let y_at = |i: usize| {
             _mm256_add_ps(
-                ld_f(l.heights.get_unchecked(i)),
+                ld_f(heights.get_unchecked(i)),
                 _mm256_sub_ps(zp, _mm256_set1_ps(*s.drop.get_unchecked(i))),
             )
         };
-        let dx_at = |i: usize| (*s.xs.get_unchecked(i) - s.xp) as f32;
+        let dx_at = |i: usize| *s.offsets_f.get_unchecked(i);
         let has_at = |i: usize| _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
         // The right end: the last sample kept (nearest P′ first), P′ before any.
         let (mut xr, mut yr, mut has_r) = (dx_next, f_next, prev_on);
@@ -389,7 +407,7 @@ impl HullsF32 {
         );
         let lo = first_from.iter().copied().min().unwrap_or(0) as usize;
         for i in (lo..k).rev() {
-            let xi = *s.xs.get_unchecked(i);
+            let xi = s.xp + *s.offsets.get_unchecked(i);
             let (y, dxi) = (y_at(i), dx_at(i));
             let dxv = _mm256_set1_ps(dxi);
             let under = _mm256_cmp_ps::<_CMP_LE_OQ>(
@@ -418,14 +436,14 @@ impl HullsF32 {
                 active,
                 _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), argmax),
             );
+            // Every sample from `lo` on is pushed in the lanes of m, none where m is empty (no
+            // pops, and a slot recorded but never read): a branch on m, taken about two times
+            // in three, cost more in mispredictions than the push it saved (4 % of a build).
             let m = _mm256_and_si256(kept, _mm256_and_si256(on, from));
-            if _mm256_testz_si256(m, m) == 0 {
-                push!(m, _mm256_set1_epi32(xi), y);
-                pushed = true;
-            }
+            push!(m, _mm256_set1_epi32(xi), y);
         }
-        // 4. P itself.
-        if pushed {
+        // 4. P itself (its pops are the far query's where nothing was pushed since).
+        if lo < k {
             push!(on, xp, fp);
         } else {
             record!(on, xp, fp);
