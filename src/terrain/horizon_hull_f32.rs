@@ -175,8 +175,8 @@ impl HullsF32 {
         let (zp, count) = (l.zp[j], l.count[j] as usize);
         let mut near = (l.own[j] - s.own_drop) * s.own_inv;
         let (mut best, mut m) = (f32::NEG_INFINITY, 0usize);
-        for i in 0..count {
-            let v = (heights[i][j] - s.near_drop[i]) * s.near_inv[i];
+        for (i, row) in heights.iter().enumerate().take(count) {
+            let v = (row[j] - s.near_drop[i]) * s.near_inv[i];
             m = if v >= best { i } else { m };
             best = best.max(v);
         }
