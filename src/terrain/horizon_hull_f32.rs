@@ -391,29 +391,29 @@ impl HullsF32 {
             )
         };
         let dx_at = |i: usize| *s.offsets_f.get_unchecked(i);
-        let has_at = |i: usize| _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32));
-        // The right end: the last sample kept (nearest P′ first), P′ before any.
+        // Where every lane has all k samples (away from the map's edge), none needs its count.
+        let full = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            count,
+            _mm256_set1_epi32(k as i32),
+        ))) == 0xff;
+        // The right end: the last sample kept (nearest P′ first), P′ before any; and its
+        // height less f_P (as the chord test from P computes it).
         let (mut xr, mut yr, mut has_r) = (dx_next, f_next, prev_on);
+        let mut yr_p = _mm256_sub_ps(yr, fp);
         // No lane pushes a sample before its period's tangent point (`from` below): the loop
         // stops at the first of those over the active lanes (k where none is active).
-        let mut first_from = [0i32; LANES];
-        _mm256_storeu_si256(
-            first_from.as_mut_ptr() as *mut __m256i,
-            _mm256_blendv_epi8(
-                _mm256_set1_epi32(k as i32),
-                argmax,
-                _mm256_and_si256(active, on),
-            ),
-        );
-        let lo = first_from.iter().copied().min().unwrap_or(0) as usize;
+        let act_on = _mm256_and_si256(active, on);
+        let lo = min_lane(_mm256_blendv_epi8(_mm256_set1_epi32(k as i32), argmax, act_on)) as usize;
+        let mut y = if lo < k { y_at(k - 1) } else { fp };
         for i in (lo..k).rev() {
             let xi = s.xp + *s.offsets.get_unchecked(i);
-            let (y, dxi) = (y_at(i), dx_at(i));
-            let dxv = _mm256_set1_ps(dxi);
+            let dxv = _mm256_set1_ps(dx_at(i));
+            let y_p = _mm256_sub_ps(y, fp);
             let under = _mm256_cmp_ps::<_CMP_LE_OQ>(
-                _mm256_mul_ps(_mm256_sub_ps(y, fp), xr),
-                _mm256_mul_ps(_mm256_sub_ps(yr, fp), dxv),
+                _mm256_mul_ps(y_p, xr),
+                _mm256_mul_ps(yr_p, dxv),
             );
+            // The left neighbour: the next sample nearer P, or P itself.
             let (xl, yl) = if i == 0 {
                 (_mm256_setzero_ps(), fp)
             } else {
@@ -424,23 +424,25 @@ impl HullsF32 {
                 _mm256_mul_ps(_mm256_sub_ps(yr, yl), _mm256_sub_ps(dxv, xl)),
             );
             let skip = _mm256_and_si256(has_r, _mm256_castps_si256(_mm256_or_ps(under, dent)));
-            let has = has_at(i);
-            let kept = _mm256_andnot_si256(skip, has);
+            let kept = if full {
+                _mm256_xor_si256(skip, _mm256_set1_epi32(-1))
+            } else {
+                _mm256_andnot_si256(skip, _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32)))
+            };
             let keptf = _mm256_castsi256_ps(kept);
-            (xr, yr, has_r) = (
+            (xr, yr, yr_p, has_r) = (
                 _mm256_blendv_ps(xr, dxv, keptf),
                 _mm256_blendv_ps(yr, y, keptf),
+                _mm256_blendv_ps(yr_p, y_p, keptf),
                 _mm256_or_si256(has_r, kept),
             );
-            let from = _mm256_and_si256(
-                active,
-                _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), argmax),
-            );
+            let from = _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), argmax);
             // Every sample from `lo` on is pushed in the lanes of m, none where m is empty (no
             // pops, and a slot recorded but never read): a branch on m, taken about two times
             // in three, cost more in mispredictions than the push it saved (4 % of a build).
-            let m = _mm256_and_si256(kept, _mm256_and_si256(on, from));
+            let m = _mm256_and_si256(kept, _mm256_and_si256(act_on, from));
             push!(m, _mm256_set1_epi32(xi), y);
+            y = yl;
         }
         // 4. P itself (its pops are the far query's where nothing was pushed since).
         if lo < k {
@@ -462,6 +464,18 @@ impl HullsF32 {
         _mm256_storeu_ps(out.as_mut_ptr(), _mm256_max_ps(near, far));
         out
     }
+}
+
+/// The least of eight i32 lanes.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn min_lane(v: std::arch::x86_64::__m256i) -> i32 {
+    use std::arch::x86_64::*;
+    let m = _mm_min_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
+    let m = _mm_min_epi32(m, _mm_shuffle_epi32::<0b01_00_11_10>(m));
+    let m = _mm_min_epi32(m, _mm_shuffle_epi32::<0b10_11_00_01>(m));
+    _mm_cvtsi128_si32(m)
 }
 
 /// One vertex of each of the eight lanes: its slot, height and τ.
