@@ -88,9 +88,9 @@ pub(super) struct HullsF32 {
     // 0, 4, 1, 5, 2, 6, 3, 7 (`store_records`).
     below: Vec<i32>,
     slot: usize,
-    top: [[i32; LANES]; 3],
-    top_y: [[f32; LANES]; 3],
-    top_x: [[i32; LANES]; 3],
+    top: [[i32; LANES]; 2],
+    top_y: [[f32; LANES]; 2],
+    top_x: [[i32; LANES]; 2],
     // Portable layout: a stack per lane.
     stacks: [LaneStack; LANES],
     /// f_P′ of the previous step, and where its pixel was on the map.
@@ -103,9 +103,9 @@ impl HullsF32 {
         HullsF32 {
             below: Vec::new(),
             slot: 1,
-            top: [[0; LANES]; 3],
-            top_y: [[0.0; LANES]; 3],
-            top_x: [[0; LANES]; 3],
+            top: [[0; LANES]; 2],
+            top_y: [[0.0; LANES]; 2],
+            top_x: [[0; LANES]; 2],
             stacks: std::array::from_fn(|_| LaneStack {
                 buf: Vec::new(),
                 len: 0,
@@ -124,9 +124,9 @@ impl HullsF32 {
         // Slot 0 is the empty hull's sentinel (slot 0 below slot 0).
         self.below[..LANES * RECORD].fill(0);
         self.slot = 1;
-        self.top = [[0; LANES]; 3];
-        self.top_y = [[0.0; LANES]; 3];
-        self.top_x = [[0; LANES]; 3];
+        self.top = [[0; LANES]; 2];
+        self.top_y = [[0.0; LANES]; 2];
+        self.top_x = [[0; LANES]; 2];
         for f in &mut self.stacks {
             if f.buf.len() < pushes + 2 {
                 f.buf.resize(pushes + 2, (0, 0.0));
@@ -309,7 +309,7 @@ impl HullsF32 {
             y: ld_f(&self.top_y[k]),
             x: ld_i(&self.top_x[k]),
         };
-        let (mut v1, mut v2, mut v3) = (top(0), top(1), top(2));
+        let (mut v1, mut v2) = (top(0), top(1));
         let below = self.below.as_mut_ptr();
         // Each lane's record within a slot, in bytes (`store_records`).
         let within = _mm256_setr_epi32(0, 32, 64, 96, 16, 48, 80, 112);
@@ -332,11 +332,11 @@ impl HullsF32 {
                         break;
                     }
                     first = false;
-                    // The third vertex moves up; the one below it comes from its slot's
-                    // record (every lane reads one; those that do not pop keep v3).
-                    let at = _mm256_add_epi32(_mm256_slli_epi32::<7>(v3.slot), within);
-                    let v4 = pick(v3, load_records(below, at), pop);
-                    (v1, v2, v3) = (pick(v1, v2, pop), pick(v2, v3, pop), v4);
+                    // The second vertex moves up; the one below it comes from its slot's
+                    // record (every lane reads one; those that do not pop keep v2).
+                    let at = _mm256_add_epi32(_mm256_slli_epi32::<7>(v2.slot), within);
+                    let v3 = load_records(below, at);
+                    (v1, v2) = (pick(v1, v2, pop), pick(v2, v3, pop));
                 }
             }};
         }
@@ -358,7 +358,7 @@ impl HullsF32 {
                     y: yq,
                     x: xq,
                 };
-                (v1, v2, v3) = (pick(v1, q, m), pick(v2, v1, m), pick(v3, v2, m));
+                (v1, v2) = (pick(v1, q, m), pick(v2, v1, m));
                 self.slot += 1;
             }};
         }
@@ -453,7 +453,7 @@ impl HullsF32 {
         let st_i = |a: &mut [i32; LANES], v: __m256i| {
             _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, v)
         };
-        for (k, v) in [v1, v2, v3].into_iter().enumerate() {
+        for (k, v) in [v1, v2].into_iter().enumerate() {
             st_i(&mut self.top[k], v.slot);
             st_i(&mut self.top_x[k], v.x);
             _mm256_storeu_ps(self.top_y[k].as_mut_ptr(), v.y);
