@@ -396,10 +396,8 @@ impl HullsF32 {
             count,
             _mm256_set1_epi32(k as i32),
         ))) == 0xff;
-        // The right end: the last sample kept (nearest P′ first), P′ before any; and its
-        // height less f_P (as the chord test from P computes it).
+        // The right end: the last sample kept (nearest P′ first), P′ before any.
         let (mut xr, mut yr, mut has_r) = (dx_next, f_next, prev_on);
-        let mut yr_p = _mm256_sub_ps(yr, fp);
         // No lane pushes a sample before its period's tangent point (`from` below): the loop
         // stops at the first of those over the active lanes (k where none is active).
         let act_on = _mm256_and_si256(active, on);
@@ -411,7 +409,7 @@ impl HullsF32 {
             let y_p = _mm256_sub_ps(y, fp);
             let under = _mm256_cmp_ps::<_CMP_LE_OQ>(
                 _mm256_mul_ps(y_p, xr),
-                _mm256_mul_ps(yr_p, dxv),
+                _mm256_mul_ps(_mm256_sub_ps(yr, fp), dxv),
             );
             // The left neighbour: the next sample nearer P, or P itself.
             let (xl, yl) = if i == 0 {
@@ -430,10 +428,9 @@ impl HullsF32 {
                 _mm256_andnot_si256(skip, _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32)))
             };
             let keptf = _mm256_castsi256_ps(kept);
-            (xr, yr, yr_p, has_r) = (
+            (xr, yr, has_r) = (
                 _mm256_blendv_ps(xr, dxv, keptf),
                 _mm256_blendv_ps(yr, y, keptf),
-                _mm256_blendv_ps(yr_p, y_p, keptf),
                 _mm256_or_si256(has_r, kept),
             );
             let from = _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), argmax);
