@@ -269,6 +269,7 @@ impl HullsF32 {
     /// AVX2 must be available; `below` must have room for k + 1 more slots, and the slices of
     /// `s` and `heights` at least k entries (k = `s.offsets.len()`), every count at most k.
     #[target_feature(enable = "avx2")]
+    #[inline]
     unsafe fn step_avx2(
         &mut self,
         s: &Step,
