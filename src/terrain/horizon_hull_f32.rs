@@ -406,7 +406,11 @@ impl HullsF32 {
         // No lane pushes a sample before its period's tangent point (`from` below): the loop
         // stops at the first of those over the active lanes (k where none is active).
         let act_on = _mm256_and_si256(active, on);
-        let lo = min_lane(_mm256_blendv_epi8(_mm256_set1_epi32(k as i32), argmax, act_on)) as usize;
+        let lo = min_lane(_mm256_blendv_epi8(
+            _mm256_set1_epi32(k as i32),
+            argmax,
+            act_on,
+        )) as usize;
         let mut y = if lo < k { y_at(k - 1) } else { fp };
         for i in (lo..k).rev() {
             let xi = s.xp + *s.offsets.get_unchecked(i);
