@@ -225,7 +225,7 @@ impl HullsF32 {
     }
 }
 
-/// Whether every lane's count lies in 0..=k (eight lanes in two compares where AVX2 is on).
+/// Whether every lane's count lies in 0..=k (a fold without an early exit: no branch per lane).
 #[inline(always)]
 fn counts_within(count: &[i32; LANES], k: usize) -> bool {
     let k = k as i32;
@@ -292,7 +292,7 @@ impl HullsF32 {
         );
         let mut best = _mm256_set1_ps(f32::NEG_INFINITY);
         let mut argmax = zero;
-        // A lane's samples past its count are −∞ (`LaneInput::heights`): they never reach
+        // A lane's samples past its count are −∞ (`heights`, [`LaneInput`]): they never reach
         // `best`, nor move `argmax` once a sample has (where none has, `best` stays −∞ and the
         // lane pushes nothing).
         for i in 0..s.offsets.len() {
