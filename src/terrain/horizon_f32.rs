@@ -474,5 +474,42 @@ mod tests {
             let same = fast.iter().zip(&slow).filter(|(a, b)| a == b).count();
             prop_assert_eq!(same, w * h, "{}x{} {:?}", w, h, d);
         }
+
+        /// `steps_within` is exactly the n with lo ≤ n·q ≤ hi (brute force over a window
+        /// wider than every answer drawn here).
+        #[test]
+        fn steps_within_is_the_brute_force_interval(
+            lo in -60i64..60, span in -5i64..60, q in -7i64..8,
+        ) {
+            let hi = lo + span;
+            let (a, b) = steps_within(lo, hi, q);
+            for n in -200i64..=200 {
+                let inside = lo <= n * q && n * q <= hi;
+                prop_assert_eq!(inside, a <= n && n <= b, "n {} q {} [{}, {}]", n, q, lo, hi);
+            }
+        }
+
+        /// A bundle's all-fit interval holds exactly the steps at which every lane's stencils
+        /// lie on the map (the box test per step that it replaces).
+        #[test]
+        fn fitting_steps_are_those_whose_stencils_lie_on_the_map(
+            w in 8usize..70, h in 8usize..70, k in 0usize..64,
+        ) {
+            let m = map(w, h, 7);
+            let d = steep(directions(64, m.cell_size)[k]);
+            let plan = Plan::new(&m, &d, None, false);
+            let (st, (wi, hi)) = (&plan.stencils, (w as i64, h as i64));
+            for &(r0, x0, n0, n1) in &bundle_list(&m, &d) {
+                let (f0, f1) = plan.fitting((r0, x0));
+                for n in n0..=n1 {
+                    let (r, c0) = (r0 + n * d.b, x0 + n * d.a);
+                    let fits = r + st.lo[1] >= 0
+                        && r + st.hi[1] < hi
+                        && c0 + st.lo[0] >= 0
+                        && c0 + LANES as i64 - 1 + st.hi[0] < wi;
+                    prop_assert_eq!(fits, f0 <= n && n <= f1, "{:?} bundle {:?} n {}", d, (r0, x0), n);
+                }
+            }
+        }
     }
 }

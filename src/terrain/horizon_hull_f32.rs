@@ -563,3 +563,26 @@ unsafe fn pick(a: Top, b: Top, m: std::arch::x86_64::__m256i) -> Top {
         x: _mm256_blendv_epi8(a.x, b.x, m),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The lane minimum of [`super::min_lane`] is the least of the eight values.
+        #[test]
+        fn min_lane_is_the_least_lane(v in prop::array::uniform8(any::<i32>())) {
+            if !crate::cpu::has_avx2() {
+                prop_assert!(std::env::var_os("CI").is_none(), "no AVX2 on this CI machine");
+                return Ok(());
+            }
+            #[cfg(target_arch = "x86_64")]
+            {
+                use std::arch::x86_64::*;
+                // SAFETY: AVX2 was detected; an unaligned load of eight i32.
+                let got = unsafe { super::min_lane(_mm256_loadu_si256(v.as_ptr() as *const __m256i)) };
+                prop_assert_eq!(got, *v.iter().min().unwrap());
+            }
+        }
+    }
+}
