@@ -62,9 +62,10 @@ struct Plan<'a> {
     units: f64,
     offsets: Vec<i32>,
     offsets_f: Vec<f32>,
-    /// The stencils in f32 with their texel offsets from the pixel: the period's, then the own
-    /// half transit.
+    /// The stencils in f32 with their texel offsets from the pixel: the period's, and the own
+    /// half transit's.
     taps: Vec<Tap>,
+    own_tap: Tap,
     /// The texel offsets from a step's lane-0 pixel of the two ends of each row its stencils
     /// read, [`AHEAD`] steps further on ([`prefetch`]).
     ahead: Vec<isize>,
@@ -110,22 +111,24 @@ impl<'a> Plan<'a> {
             offsets: Vec::new(),
             offsets_f: Vec::new(),
             taps: Vec::new(),
+            own_tap: Tap {
+                at: 0,
+                tx: 0.0,
+                ty: 0.0,
+            },
             ahead: Vec::new(),
         };
         plan.offsets = plan.ts.iter().map(|&t| plan.fixed(t)).collect();
         plan.offsets_f = plan.offsets.iter().map(|&o| o as f32).collect();
         let w = map.width as isize;
         let st = &plan.stencils;
-        plan.taps = st
-            .period
-            .iter()
-            .chain([&st.own])
-            .map(|s| Tap {
-                at: s.dy as isize * w + s.dx as isize,
-                tx: s.tx as f32,
-                ty: s.ty as f32,
-            })
-            .collect();
+        let tap = |s: &super::horizon::Stencil| Tap {
+            at: s.dy as isize * w + s.dx as isize,
+            tx: s.tx as f32,
+            ty: s.ty as f32,
+        };
+        plan.taps = st.period.iter().map(tap).collect();
+        plan.own_tap = tap(&st.own);
         let back = AHEAD as isize * (dir.b as isize * w + dir.a as isize);
         plan.ahead = (st.lo[1]..=st.hi[1])
             .flat_map(|y| {
@@ -374,7 +377,6 @@ fn eval_lanes(
     own: &mut [f32; LANES],
 ) {
     let (hs, w) = (&plan.map.heights[..], plan.map.width);
-    let (period, last) = plan.taps.split_at(plan.taps.len() - 1);
     #[cfg(target_arch = "x86_64")]
     if plan.avx2 {
         // Every tap of every lane on the map (the caller's test), checked once for the box.
@@ -385,10 +387,10 @@ fn eval_lanes(
         // SAFETY: AVX2 was detected; every tap lies in the box just checked.
         unsafe {
             let p = hs.as_ptr().add(base);
-            for (tap, out) in period.iter().zip(heights.iter_mut()) {
+            for (tap, out) in plan.taps.iter().zip(heights.iter_mut()) {
                 eval_avx2(tap, p, w, z, out);
             }
-            eval_avx2(&last[0], p, w, z, own);
+            eval_avx2(&plan.own_tap, p, w, z, own);
         }
         return;
     }
@@ -408,11 +410,10 @@ fn eval_lane(
     own: &mut [f32; LANES],
 ) {
     let (hs, w) = (&plan.map.heights[..], plan.map.width);
-    let (period, last) = plan.taps.split_at(plan.taps.len() - 1);
-    for (tap, row) in period.iter().zip(heights.iter_mut()) {
+    for (tap, row) in plan.taps.iter().zip(heights.iter_mut()) {
         row[j] = eval_f32(tap, hs, pixel, w, z);
     }
-    own[j] = eval_f32(&last[0], hs, pixel, w, z);
+    own[j] = eval_f32(&plan.own_tap, hs, pixel, w, z);
 }
 
 /// [`eval_f32`] of the eight lanes whose pixel 0 is at `p`: the same operations, the same bits.
