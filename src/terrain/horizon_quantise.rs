@@ -1,20 +1,36 @@
 //! The horizon f32 sweep's quantisation ([`super::horizon_f32`]): each lane's slope to the
-//! horizon map's u16 step, through Cephes' `atanf` in f32 and [`encode`] in f64, eight lanes
-//! per AVX2 instruction with a portable twin that gives the same u16 (a proptest).
+//! horizon map's u16 step, through Cephes' `atanf` in f32 and the step count in f32, eight
+//! lanes per AVX2 instruction with a portable twin that gives the same u16 (a proptest).
+//!
+//! **The step in f32.** `encode` rounds x = (deg + 90)/STEP_DEG in f64. Here the angle stays
+//! in radians and x − ½ = atan·K + 32767 with K = 65535/π, rounded up (ties down, so that flat
+//! ground's 0° gives 32767 as `encode` does). Both f32 roundings together are at most 2⁻¹⁰ +
+//! 2⁻¹⁰ of a step (the product below 2¹⁵, the sum below 2¹⁶), less than the `atanf` error
+//! itself (2 ulp of π/2: 5·10⁻³ of a step), and the old path's f32 conversion to degrees
+//! cost as much (1.4·10⁻³ of a step). So a value can differ from `encode`'s by one step only
+//! within 0.01 of a step from a midpoint; the unit test bounds every value's distance from
+//! the exact step of the f32 slope, and `tests/terrain_horizon.rs` the map's from the exact
+//! horizon. It saves the two f64 divisions and conversions of `encode` per eight lanes.
 
-use super::horizon::{encode, STEP_DEG};
 use super::horizon_hull::LANES;
 
-/// Slopes (t units) to the horizon map's u16: atan of slope/metres_per_t in degrees
-/// ([`atan_f32`]), then [`encode`]'s step in f64, as the f64 sweep's map is quantised (flat
-/// ground's 0° is 90/STEP_DEG = 32767.499999999996 steps in f64, so 32767 in both). The
-/// portable twin of [`quantise_avx2`].
+/// 65535/π: u16 steps per radian (the map's step is 180°/65535).
+const STEPS_PER_RAD: f32 = (65535.0 / std::f64::consts::PI) as f32;
+
+/// The u16 step of an angle `atan` (radians, from [`atan_f32`]): ⌈atan·K + 32767⌉ clamped to
+/// the u16 range (module notes); a NaN gives 0, as `encode` does.
+#[inline(always)]
+fn step_of(atan: f32) -> u16 {
+    (atan * STEPS_PER_RAD + 32767.0).ceil().clamp(0.0, 65535.0) as u16
+}
+
+/// Slopes (t units) to the horizon map's u16: atan of slope/metres_per_t ([`atan_f32`]), then
+/// its step ([`step_of`]). The portable twin of [`quantise_avx2`].
 #[inline(always)]
 fn quantise(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
     let mut out = [0u16; LANES];
     for (o, &s) in out.iter_mut().zip(slopes) {
-        let deg = atan_f32(s * inv_m) * (180.0 / std::f32::consts::PI);
-        *o = encode(deg as f64);
+        *o = step_of(atan_f32(s * inv_m));
     }
     out
 }
@@ -32,9 +48,7 @@ pub(super) fn quantise_lanes(slopes: &[f32; LANES], inv_m: f32, avx2: bool) -> [
     quantise(slopes, inv_m)
 }
 
-/// [`quantise`] on eight lanes: [`atan_f32`]'s selects as blends, then [`encode`] in two
-/// halves of four f64 lanes. A NaN slope gives 0 as `encode` does (`max` returns its second
-/// operand, −90°, for a NaN first one).
+/// [`quantise`] on eight lanes: [`atan_f32`]'s selects as blends, then [`step_of`].
 ///
 /// # Safety
 /// AVX2 must be available.
@@ -64,28 +78,13 @@ unsafe fn quantise_avx2(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
     p = _mm256_sub_ps(_mm256_mul_ps(p, z), f(c3));
     p = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(p, z), r), r);
     let atan = _mm256_or_ps(_mm256_andnot_ps(f(-0.0), _mm256_add_ps(base, p)), sign);
-    let deg = _mm256_mul_ps(atan, f(180.0 / std::f32::consts::PI));
-    let half = |d: __m128| {
-        let d = _mm256_max_pd(_mm256_cvtps_pd(d), _mm256_set1_pd(-90.0));
-        let d = _mm256_min_pd(d, _mm256_set1_pd(90.0));
-        let x = _mm256_div_pd(
-            _mm256_add_pd(d, _mm256_set1_pd(90.0)),
-            _mm256_set1_pd(STEP_DEG),
-        );
-        let whole = _mm256_cvttpd_epi32(x);
-        let frac = _mm256_sub_pd(x, _mm256_cvtepi32_pd(whole));
-        let up = _mm256_cmp_pd::<_CMP_GE_OQ>(frac, _mm256_set1_pd(0.5));
-        // The all-ones mask of four lanes, packed to i32, is −1: subtracting it adds one.
-        let up = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(
-            _mm256_castpd_si256(up),
-            _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6),
-        ));
-        _mm_sub_epi32(whole, up)
-    };
-    let lo = half(_mm256_castps256_ps128(deg));
-    let hi = half(_mm256_extractf128_ps::<1>(deg));
+    // The step (`step_of`): ceil is exact; `max` returns its second operand, 0, for NaN.
+    let x = _mm256_add_ps(_mm256_mul_ps(atan, f(STEPS_PER_RAD)), f(32767.0));
+    let x = _mm256_min_ps(_mm256_max_ps(_mm256_ceil_ps(x), f(0.0)), f(65535.0));
+    let q = _mm256_cvttps_epi32(x);
     let mut out = [0u16; LANES];
-    _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, _mm_packus_epi32(lo, hi));
+    let q = _mm_packus_epi32(_mm256_castsi256_si128(q), _mm256_extracti128_si256::<1>(q));
+    _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, q);
     out
 }
 
@@ -175,6 +174,50 @@ mod tests {
             prop_assert_eq!(quantise_lanes(&slopes, inv_m, true), quantise(&slopes, inv_m));
         }
     }
+
+    /// Every step against the exact one of its f32 slope (f64 `atan`, unrounded): within half
+    /// a step plus [`STEP_SLACK`]; flat ground (±0) gives 32767 as `encode` does, ±∞ the ends,
+    /// NaN 0. Slopes over every magnitude and, for each step, the f32 slopes at its midpoint.
+    #[test]
+    fn steps_are_the_exact_ones_within_rounding() {
+        use crate::terrain::horizon::encode;
+        let k = 65535.0 / std::f64::consts::PI;
+        let mut vs: Vec<f32> =
+            crate::terrain::horizon_hull::test_values::magnitudes(200_000, 24, 30)
+                .into_iter()
+                .flat_map(|v| [v as f32, -(v as f32)])
+                .collect();
+        for q in 0..65535u32 {
+            let mid = ((q as f64 + 0.5 - 32767.5) / k).tan() as f32;
+            // The f32 values around it, an ulp or so apart.
+            vs.extend((-3..=3).map(|j| mid * (1.0 + j as f32 * f32::EPSILON)));
+        }
+        let (mut worst, mut off_encode) = (0.0f64, 0usize);
+        for &v in &vs {
+            let x = (v as f64).atan() * k + 32767.5;
+            let q = step_of(atan_f32(v));
+            worst = worst.max((q as f64 - x).abs());
+            let e = encode(atan_f32(v) as f64 * (180.0 / std::f64::consts::PI));
+            assert!(q.abs_diff(e) <= 1, "{v:e}: {q} against encode's {e}");
+            off_encode += (q != e) as usize;
+        }
+        eprintln!(
+            "worst {:.5} steps; {off_encode} of {} differ from encode's",
+            worst,
+            vs.len()
+        );
+        assert!(worst <= 0.5 + STEP_SLACK, "worst {worst} steps");
+        assert_eq!(
+            [step_of(atan_f32(0.0)), step_of(atan_f32(-0.0))],
+            [32767; 2]
+        );
+        let ends = [f32::INFINITY, f32::NEG_INFINITY, f32::NAN].map(|v| step_of(atan_f32(v)));
+        assert_eq!(ends, [65535, 0, 0]);
+    }
+
+    /// What the f32 step may add to half a step: 2 ulp of `atanf` at π/2 (5.0·10⁻³ of a step)
+    /// and the two f32 roundings (2·2⁻¹⁰), with a margin of 1.5x.
+    const STEP_SLACK: f64 = 0.011;
 
     /// The f32 atan against f64's over every magnitude (with ±0, the break points and ±∞).
     #[test]
