@@ -37,9 +37,9 @@
 //!
 //! **Layout of the AVX2 hulls.** Each push takes a slot (the same for every lane; a lane that
 //! does not push leaves it unused) that records, per lane, the vertex below the pushed one:
-//! its slot, height and τ, as one 16-byte record. A lane's top two vertices live in
-//! registers; each pop round reads the third from the second one's slot while it tests the
-//! top two (AVX2 has sixteen registers: a third vertex in them made the compiler spill the
+//! the byte offset of its own record (so that a pop reads it with no arithmetic), its height
+//! and τ, as one 16-byte record. A lane's top two vertices live in registers; each pop round
+//! reads the third from the second one's record while it tests the top two (AVX2 has sixteen registers: a third vertex in them made the compiler spill the
 //! period loop's state, and reading it cost 2 % less than keeping it). The eight lanes'
 //! records are eight 16-byte loads and a transpose: Zen 3 spends 39 µops on each eight-lane
 //! gather, and three gathers per pop round (one per field) took 17 % of a build; the records
@@ -88,7 +88,8 @@ pub(super) struct LaneInput {
 /// The hulls of one bundle's lanes.
 pub(super) struct HullsF32 {
     // AVX2 layout: per slot and lane, the vertex below the one pushed there, as a record
-    // [slot, y bits, x, x] of four i32 (`RECORD`); a slot's eight records in lane order
+    // [at, y bits, x, x] of four i32 (`RECORD`; `at` is the byte offset of the vertex's own
+    // record, `Top`); a slot's eight records in lane order
     // 0, 4, 1, 5, 2, 6, 3, 7 (`store_records`).
     below: Vec<i32>,
     slot: usize,
@@ -122,13 +123,22 @@ impl HullsF32 {
     /// Empty every lane, with room for `pushes` pushes of the AVX2 path.
     pub fn reset(&mut self, pushes: usize) {
         let n = (pushes + 1) * LANES * RECORD;
+        // A record's byte offset is an i32 lane.
+        assert!(n * 4 <= i32::MAX as usize, "a bundle of {pushes} pushes");
         if self.below.len() < n {
             self.below.resize(n, 0);
         }
-        // Slot 0 is the empty hull's sentinel (slot 0 below slot 0).
-        self.below[..LANES * RECORD].fill(0);
+        // Slot 0 is the empty hull's sentinel (slot 0 below slot 0): each of its records
+        // points at itself.
+        for (i, r) in self.below[..LANES * RECORD]
+            .chunks_exact_mut(RECORD)
+            .enumerate()
+        {
+            r.fill(0);
+            r[0] = (i * RECORD * 4) as i32;
+        }
         self.slot = 1;
-        self.top = [[0; LANES]; 2];
+        self.top = [WITHIN; 2];
         self.top_y = [[0.0; LANES]; 2];
         self.top_x = [[0; LANES]; 2];
         for f in &mut self.stacks {
@@ -157,7 +167,8 @@ impl HullsF32 {
             assert!(self.below.len() >= (self.slot + k + 1) * LANES * RECORD);
             assert!(heights.len() >= k && s.drop.len() >= k && s.offsets_f.len() >= k);
             assert!(s.near_drop.len() >= k && s.near_inv.len() >= k);
-            assert!(counts_within(&l.count, k));
+            // The counts only mask lanes (no load depends on them): a check for debug builds.
+            debug_assert!(counts_within(&l.count, k));
             // SAFETY: AVX2 was detected; the asserts above give the slots and the lengths.
             return unsafe { self.step_avx2(s, l, heights) };
         }
@@ -225,7 +236,7 @@ impl HullsF32 {
     }
 }
 
-/// Whether every lane's count lies in 0..=k (a fold without an early exit: no branch per lane).
+/// Whether every lane's count lies in 0..=k.
 #[inline(always)]
 fn counts_within(count: &[i32; LANES], k: usize) -> bool {
     let k = k as i32;
@@ -271,7 +282,8 @@ impl HullsF32 {
     ///
     /// # Safety
     /// AVX2 must be available; `below` must have room for k + 1 more slots, and the slices of
-    /// `s` and `heights` at least k entries (k = `s.offsets.len()`), every count at most k.
+    /// `s` and `heights` at least k entries (k = `s.offsets.len()`). (A count over k, or
+    /// negative, would give wrong slopes but read nothing out of bounds: counts only mask.)
     #[target_feature(enable = "avx2")]
     #[inline]
     unsafe fn step_avx2(
@@ -308,16 +320,16 @@ impl HullsF32 {
             best = _mm256_max_ps(best, v);
         }
         near = _mm256_max_ps(near, best);
-        // The top two vertices of every lane: slot, height, τ.
+        // The top two vertices of every lane: record, height, τ.
         let top = |k: usize| Top {
-            slot: ld_i(&self.top[k]),
+            at: ld_i(&self.top[k]),
             y: ld_f(&self.top_y[k]),
             x: ld_i(&self.top_x[k]),
         };
         let (mut v1, mut v2) = (top(0), top(1));
         let below = self.below.as_mut_ptr();
-        // Each lane's record within a slot, in bytes (`store_records`).
-        let within = _mm256_setr_epi32(0, 32, 64, 96, 16, 48, 80, 112);
+        // Each lane's record within a slot, in bytes (`store_records`): the sentinel's.
+        let within = ld_i(&WITHIN);
         // Pop, in the lanes of mask m, while the top vertex fails the test against (xq, yq).
         macro_rules! pop_while {
             ($m:expr, $xq:expr, $yq:expr) => {{
@@ -328,7 +340,7 @@ impl HullsF32 {
                     let dx2 = _mm256_cvtepi32_ps(_mm256_sub_epi32(v2.x, xq));
                     let l = _mm256_mul_ps(_mm256_sub_ps(v1.y, yq), dx2);
                     let r = _mm256_mul_ps(_mm256_sub_ps(v2.y, yq), dx1);
-                    let deep = _mm256_andnot_si256(_mm256_cmpeq_epi32(v2.slot, zero), m);
+                    let deep = _mm256_andnot_si256(_mm256_cmpeq_epi32(v2.at, within), m);
                     let pop = _mm256_and_si256(
                         deep,
                         _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OQ>(l, r)),
@@ -337,10 +349,9 @@ impl HullsF32 {
                         break;
                     }
                     first = false;
-                    // The second vertex moves up; the one below it comes from its slot's
-                    // record (every lane reads one; those that do not pop keep v2).
-                    let at = _mm256_add_epi32(_mm256_slli_epi32::<7>(v2.slot), within);
-                    let v3 = load_records(below, at);
+                    // The second vertex moves up; the one below it comes from its record
+                    // (every lane reads one; those that do not pop keep v2).
+                    let v3 = load_records(below, v2.at);
                     (v1, v2) = (pick(v1, v2, pop), pick(v2, v3, pop));
                 }
             }};
@@ -359,7 +370,10 @@ impl HullsF32 {
                 let (m, xq, yq) = ($m, $xq, $yq);
                 store_records(below.add(self.slot * LANES * RECORD), v1);
                 let q = Top {
-                    slot: _mm256_set1_epi32(self.slot as i32),
+                    at: _mm256_add_epi32(
+                        _mm256_set1_epi32((self.slot * LANES * RECORD * 4) as i32),
+                        within,
+                    ),
                     y: yq,
                     x: xq,
                 };
@@ -381,7 +395,7 @@ impl HullsF32 {
             ),
             _mm256_set1_ps(s.shift),
         );
-        let empty = _mm256_castsi256_ps(_mm256_cmpeq_epi32(v1.slot, zero));
+        let empty = _mm256_castsi256_ps(_mm256_cmpeq_epi32(v1.at, within));
         let far = _mm256_blendv_ps(far, _mm256_set1_ps(f32::NEG_INFINITY), empty);
         // 3. Where the period's largest slope beats the far one, its samples from m on that lie
         // above the chord from P to P′ (all of them where P′ is off) and their neighbours.
@@ -460,7 +474,7 @@ impl HullsF32 {
             _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, v)
         };
         for (k, v) in [v1, v2].into_iter().enumerate() {
-            st_i(&mut self.top[k], v.slot);
+            st_i(&mut self.top[k], v.at);
             st_i(&mut self.top_x[k], v.x);
             _mm256_storeu_ps(self.top_y[k].as_mut_ptr(), v.y);
         }
@@ -484,17 +498,22 @@ unsafe fn min_lane(v: std::arch::x86_64::__m256i) -> i32 {
     _mm_cvtsi128_si32(m)
 }
 
-/// One vertex of each of the eight lanes: its slot, height and τ.
+/// One vertex of each of the eight lanes: the byte offset of its record (its slot's, at the
+/// lane's place in it: what the vertex above it reads), its height and τ.
 #[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy)]
 struct Top {
-    slot: std::arch::x86_64::__m256i,
+    at: std::arch::x86_64::__m256i,
     y: std::arch::x86_64::__m256,
     x: std::arch::x86_64::__m256i,
 }
 
-/// i32 per record of the AVX2 hulls: slot, y's bits, x, and x again (padding).
+/// i32 per record of the AVX2 hulls: at, y's bits, x, and x again (padding).
 const RECORD: usize = 4;
+
+/// Each lane's record within a slot, in bytes ([`store_records`]' order): 32·(j mod 4) +
+/// 16·(j div 4).
+const WITHIN: [i32; LANES] = [0, 32, 64, 96, 16, 48, 80, 112];
 
 /// Record the eight lanes' vertices `v` at `to` (one slot): lanes j and j + 4 share 32 bytes,
 /// so lane j's record starts at byte 32·(j mod 4) + 16·(j div 4).
@@ -508,8 +527,8 @@ unsafe fn store_records(to: *mut i32, v: Top) {
     use std::arch::x86_64::*;
     let y = _mm256_castps_si256(v.y);
     let (a, b) = (
-        _mm256_unpacklo_epi32(v.slot, y),
-        _mm256_unpackhi_epi32(v.slot, y),
+        _mm256_unpacklo_epi32(v.at, y),
+        _mm256_unpackhi_epi32(v.at, y),
     );
     let (c, d) = (
         _mm256_unpacklo_epi32(v.x, v.x),
@@ -545,7 +564,7 @@ unsafe fn load_records(base: *const i32, at: std::arch::x86_64::__m256i) -> Top 
     let (t0, t1) = (_mm256_unpacklo_epi32(r0, r1), _mm256_unpacklo_epi32(r2, r3));
     let (t2, t3) = (_mm256_unpackhi_epi32(r0, r1), _mm256_unpackhi_epi32(r2, r3));
     Top {
-        slot: _mm256_unpacklo_epi64(t0, t1),
+        at: _mm256_unpacklo_epi64(t0, t1),
         y: _mm256_castsi256_ps(_mm256_unpackhi_epi64(t0, t1)),
         x: _mm256_unpacklo_epi64(t2, t3),
     }
@@ -558,7 +577,7 @@ unsafe fn load_records(base: *const i32, at: std::arch::x86_64::__m256i) -> Top 
 unsafe fn pick(a: Top, b: Top, m: std::arch::x86_64::__m256i) -> Top {
     use std::arch::x86_64::*;
     Top {
-        slot: _mm256_blendv_epi8(a.slot, b.slot, m),
+        at: _mm256_blendv_epi8(a.at, b.at, m),
         y: _mm256_blendv_ps(a.y, b.y, _mm256_castsi256_ps(m)),
         x: _mm256_blendv_epi8(a.x, b.x, m),
     }
