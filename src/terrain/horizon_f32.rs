@@ -299,6 +299,7 @@ fn bundle_lanes(
             near_inv: &plan.near_inv,
             own_drop: (kappa * st.own.t * st.own.t) as f32,
             own_inv: (1.0 / st.own.t) as f32,
+            next: plan.fixed(tau + plan.period_t) - xp,
             dx_next: (plan.fixed(tau + plan.period_t) - xp) as f32,
             scale: plan.units as f32,
             shift: (2.0 * kappa * tau) as f32,

@@ -3,30 +3,34 @@
 //! lane (a proptest holds the two bit for bit equal).
 //!
 //! **One pixel step of a lane** (pixel P at τ_P on the line, f_P = z_P − κτ_P², the line's
-//! parabola as in [`super::horizon`]):
+//! parabola as in [`super::horizon`]; P′ = P + (a, b), the pixel of the step before):
 //! 1. *Near:* the slope to P's own half transit and to each sample of its period, directly
-//!    from the times t_s of the period ((h_s − κt_s² − z_P)/t_s: no large coordinates).
-//! 2. *Far:* the tangent from (τ_P, f_P) to the hull, which holds every sample from P′ = P +
-//!    (a, b) on (at least one period away), popping the vertices before the tangent point: they
-//!    lie under the chord from P (pushed in step 4) to the tangent point, so no pixel further
-//!    back can need them (Timonen & Westerholm's amortised O(1) query).
-//! 3. *Period pushes*, in decreasing τ, of the samples from the period's tangent point on, and
-//!    only where it beats the far tangent. After P is pushed (step 4), the hull's vertex after
-//!    P is the point of largest slope from P over everything to its right (ties: the farthest);
-//!    every sample between P and that point lies under the chord to it and can be the tangent
-//!    point of no pixel behind P. So a lane whose far slope is at least the period's largest
-//!    pushes nothing from the period, nor pops again in step 4 (step 2's query made the same
-//!    test), and one whose period wins pushes from its last sample of largest slope, m, on.
-//!    Of those, a sample under the chord from P, or from its left neighbour, to the last
-//!    sample kept to its right (P′ before any) is skipped too: it lies under a segment
+//!    from the times t_s of the period ((h_s − κt_s² − z_P)/t_s: no large coordinates), and
+//!    to P′, the period's far end (a pixel's full transit of its texel is its centre: a chord
+//!    through a square's centre is halved there), from the two f values.
+//! 2. *Far:* the tangent from (τ_P, f_P) to the hull, which holds the samples beyond P′ that
+//!    pixels nearer the line's start may still need, popping the vertices before the tangent
+//!    point: they lie under the chord from P to the tangent point, so no pixel further back
+//!    can need them (Timonen & Westerholm's amortised O(1) query).
+//! 3. *Pushes*, in decreasing τ, of the period's samples and P′ from the last of largest
+//!    slope from P (m; ties: the farthest) on, and only where that slope beats the far
+//!    tangent. Every sample between P and m lies under the chord from P to m; where the far
+//!    tangent wins, every sample of the period and P′ lies under the chord from P to the far
+//!    tangent point: such a sample can be the tangent point of no pixel behind P, seen
+//!    through P (which step 3 of the next step considers as its P′). Of those from m on, a
+//!    sample under the chord from P, or from its left neighbour, to the last sample kept to
+//!    its right (the far tangent point before any) is skipped too: it lies under a segment
 //!    between two samples of the line, one on each side, so seen from any point further left
 //!    its slope is at most one of theirs. On Puget Sound (1024², 64 directions) the period
-//!    wins in 37 % of the lane steps, and the lane pushes fall from 2.18 to 1.39 per step
-//!    against the chord and neighbour tests alone; taking the last sample *kept* as the
-//!    right end, not the next one, takes off another 19 % of lane pushes (12 % of the vector
-//!    pushes), with the same bits.
-//! 4. *P itself* (the full transit of its texel is its centre: a chord through a square's
-//!    centre is halved there), for the pixels behind it.
+//!    won in 37 % of the lane steps when P′ was pushed as such, and the lane pushes fell from
+//!    2.18 to 1.39 per step against the chord and neighbour tests alone; taking the last
+//!    sample *kept* as the right end, not the next one, took off another 19 % of lane pushes
+//!    (12 % of the vector pushes), with the same bits.
+//!
+//! P itself is not pushed: the next step decides on it as its P′. Pushed at every step, P was
+//! popped again by the next step's far query in most lanes (2.6 pop rounds per step, P's push
+//! 0.6 more rounds and a record); as the period's far end it costs a few lane tests, and the
+//! planes of Puget Sound at 512² and 1024² came out the same bits.
 //!
 //! The lane's answer is max(near, far) in t units (a slope per unit of τ).
 //!
@@ -66,7 +70,9 @@ pub(super) struct Step<'a> {
     pub near_inv: &'a [f32],
     pub own_drop: f32,
     pub own_inv: f32,
-    /// τ_P′ − τ_P as f32 (fixed point units), 2^F, and the curvature shift 2κτ_P.
+    /// τ_P′ − τ_P in fixed point units (exact, and as f32), 2^F, and the curvature shift
+    /// 2κτ_P.
+    pub next: i32,
     pub dx_next: f32,
     pub scale: f32,
     pub shift: f32,
@@ -184,10 +190,10 @@ impl HullsF32 {
         out
     }
 
-    /// Lane j's step (module notes, steps 1–4): the portable kernel.
+    /// Lane j's step (module notes, steps 1–3): the portable kernel.
     #[inline(always)]
     fn step_lane(&mut self, s: &Step, l: &LaneInput, heights: &[[f32; LANES]], j: usize) -> f32 {
-        let (zp, count) = (l.zp[j], l.count[j] as usize);
+        let (zp, count, k) = (l.zp[j], l.count[j] as usize, s.offsets.len());
         let mut near = (l.own[j] - s.own_drop) * s.own_inv;
         let (mut best, mut m) = (f32::NEG_INFINITY, 0usize);
         for (i, row) in heights.iter().enumerate().take(count) {
@@ -195,23 +201,38 @@ impl HullsF32 {
             m = if v >= best { i } else { m };
             best = best.max(v);
         }
-        near = near.max(best);
         let fp = zp - s.drop_p;
+        // P′, the period's far end (index k), where it is on the map.
+        let (prev_on, f_next) = (self.prev_on[j] != 0, self.f_prev[j]);
+        if prev_on {
+            let v = (f_next - fp) / s.dx_next * s.scale + s.shift;
+            m = if v >= best { k } else { m };
+            best = best.max(v);
+        }
+        near = near.max(best);
         let st = &mut self.stacks[j];
         st.pop_while(s.xp, fp);
-        let far = if st.len > 0 {
+        let (far, mut right) = if st.len > 0 {
             let (x1, y1) = st.top();
-            (y1 - fp) / (x1 - s.xp) as f32 * s.scale + s.shift
+            let dx = (x1 - s.xp) as f32;
+            ((y1 - fp) / dx * s.scale + s.shift, Some((dx, y1)))
         } else {
-            f32::NEG_INFINITY
+            (f32::NEG_INFINITY, None)
         };
         if best > far {
-            let (prev_on, f_next) = (self.prev_on[j] != 0, self.f_prev[j]);
-            let y = |i: usize| heights[i][j] + (zp - s.drop[i]);
-            let dx = |i: usize| s.offsets_f[i];
-            // The right end: the last sample kept, P′ before any.
-            let mut right = prev_on.then_some((s.dx_next, f_next));
-            for i in (m..count).rev() {
+            let y = |i: usize| {
+                if i == k {
+                    f_next
+                } else {
+                    heights[i][j] + (zp - s.drop[i])
+                }
+            };
+            let dx = |i: usize| if i == k { s.dx_next } else { s.offsets_f[i] };
+            // The right end: the last sample kept, the far tangent point before any.
+            for i in (m..=k).rev() {
+                if (i == k && !prev_on) || (i < k && i >= count) {
+                    continue;
+                }
                 let yi = y(i);
                 let (xl, yl) = if i == 0 {
                     (0.0, fp)
@@ -226,12 +247,11 @@ impl HullsF32 {
                     }
                 }
                 right = Some((dx(i), yi));
-                st.pop_while(s.xp + s.offsets[i], yi);
-                st.push(s.xp + s.offsets[i], yi);
+                let x = s.xp + if i == k { s.next } else { s.offsets[i] };
+                st.pop_while(x, yi);
+                st.push(x, yi);
             }
-            st.pop_while(s.xp, fp);
         }
-        st.push(s.xp, fp);
         near.max(far)
     }
 }
@@ -319,6 +339,27 @@ impl HullsF32 {
             argmax = _mm256_blendv_epi8(argmax, _mm256_set1_epi32(i as i32), ge);
             best = _mm256_max_ps(best, v);
         }
+        // P′, the period's far end (index k), where it is on the map.
+        let xp = _mm256_set1_epi32(s.xp);
+        let fp = _mm256_sub_ps(zp, _mm256_set1_ps(s.drop_p));
+        let k = s.offsets.len();
+        let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
+        let dx_next = _mm256_set1_ps(s.dx_next);
+        let slope_next = _mm256_add_ps(
+            _mm256_mul_ps(
+                _mm256_div_ps(_mm256_sub_ps(f_next, fp), dx_next),
+                _mm256_set1_ps(s.scale),
+            ),
+            _mm256_set1_ps(s.shift),
+        );
+        let slope_next = _mm256_blendv_ps(
+            _mm256_set1_ps(f32::NEG_INFINITY),
+            slope_next,
+            _mm256_castsi256_ps(prev_on),
+        );
+        let ge = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(slope_next, best));
+        argmax = _mm256_blendv_epi8(argmax, _mm256_set1_epi32(k as i32), ge);
+        best = _mm256_max_ps(best, slope_next);
         near = _mm256_max_ps(near, best);
         // The top two vertices of every lane: record, height, τ.
         let top = |k: usize| Top {
@@ -382,27 +423,24 @@ impl HullsF32 {
             }};
         }
         // 2. Far: the tangent from (τ_P, f_P).
-        let xp = _mm256_set1_epi32(s.xp);
-        let fp = _mm256_sub_ps(zp, _mm256_set1_ps(s.drop_p));
         pop_while!(on, xp, fp);
+        let dx_far = _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xp));
         let far = _mm256_add_ps(
             _mm256_mul_ps(
-                _mm256_div_ps(
-                    _mm256_sub_ps(v1.y, fp),
-                    _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xp)),
-                ),
+                _mm256_div_ps(_mm256_sub_ps(v1.y, fp), dx_far),
                 _mm256_set1_ps(s.scale),
             ),
             _mm256_set1_ps(s.shift),
         );
-        let empty = _mm256_castsi256_ps(_mm256_cmpeq_epi32(v1.at, within));
-        let far = _mm256_blendv_ps(far, _mm256_set1_ps(f32::NEG_INFINITY), empty);
+        let empty = _mm256_cmpeq_epi32(v1.at, within);
+        let far = _mm256_blendv_ps(
+            far,
+            _mm256_set1_ps(f32::NEG_INFINITY),
+            _mm256_castsi256_ps(empty),
+        );
         // 3. Where the period's largest slope beats the far one, its samples from m on that lie
-        // above the chord from P to P′ (all of them where P′ is off) and their neighbours.
+        // above the chord from P to the far tangent point and their neighbours' segments.
         let active = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(best, far));
-        let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
-        let dx_next = _mm256_set1_ps(s.dx_next);
-        let k = s.offsets.len();
         let y_at = |i: usize| {
             _mm256_add_ps(
                 ld_f(heights.get_unchecked(i)),
@@ -415,20 +453,24 @@ impl HullsF32 {
             count,
             _mm256_set1_epi32(k as i32),
         ))) == 0xff;
-        // The right end: the last sample kept (nearest P′ first), P′ before any.
-        let (mut xr, mut yr, mut has_r) = (dx_next, f_next, prev_on);
+        // The right end: the last sample kept (P′ first), the far tangent point before any.
+        let (mut xr, mut yr) = (dx_far, v1.y);
+        let mut has_r = _mm256_xor_si256(empty, _mm256_set1_epi32(-1));
         // No lane pushes a sample before its period's tangent point (`from` below): the loop
-        // stops at the first of those over the active lanes (k where none is active).
+        // stops at the first of those over the active lanes (none where none is active).
         let act_on = _mm256_and_si256(active, on);
         let lo = min_lane(_mm256_blendv_epi8(
-            _mm256_set1_epi32(k as i32),
+            _mm256_set1_epi32(k as i32 + 1),
             argmax,
             act_on,
         )) as usize;
-        let mut y = if lo < k { y_at(k - 1) } else { fp };
-        for i in (lo..k).rev() {
-            let xi = s.xp + *s.offsets.get_unchecked(i);
-            let dxv = _mm256_set1_ps(dx_at(i));
+        let mut y = f_next;
+        for i in (lo..=k).rev() {
+            let (xi, dxv) = if i == k {
+                (s.xp + s.next, dx_next)
+            } else {
+                (s.xp + *s.offsets.get_unchecked(i), _mm256_set1_ps(dx_at(i)))
+            };
             let y_p = _mm256_sub_ps(y, fp);
             let under = _mm256_cmp_ps::<_CMP_LE_OQ>(
                 _mm256_mul_ps(y_p, xr),
@@ -445,7 +487,9 @@ impl HullsF32 {
                 _mm256_mul_ps(_mm256_sub_ps(yr, yl), _mm256_sub_ps(dxv, xl)),
             );
             let skip = _mm256_and_si256(has_r, _mm256_castps_si256(_mm256_or_ps(under, dent)));
-            let kept = if full {
+            let kept = if i == k {
+                _mm256_andnot_si256(skip, prev_on)
+            } else if full {
                 _mm256_xor_si256(skip, _mm256_set1_epi32(-1))
             } else {
                 _mm256_andnot_si256(skip, _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32)))
@@ -463,12 +507,6 @@ impl HullsF32 {
             let m = _mm256_and_si256(kept, _mm256_and_si256(act_on, from));
             push!(m, _mm256_set1_epi32(xi), y);
             y = yl;
-        }
-        // 4. P itself (its pops are the far query's where nothing was pushed since).
-        if lo < k {
-            push!(on, xp, fp);
-        } else {
-            record!(on, xp, fp);
         }
         let st_i = |a: &mut [i32; LANES], v: __m256i| {
             _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, v)
