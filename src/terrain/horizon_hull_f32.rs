@@ -372,10 +372,14 @@ impl HullsF32 {
         // Each lane's record within a slot, in bytes (`store_records`): the sentinel's.
         let within = ld_i(&WITHIN);
         // Pop, in the lanes of mask m, while the top vertex fails the test against (xq, yq).
+        // With `eager`, the first round reads the third vertex before its test's branch: the
+        // far query's first round pops somewhere in most steps, a push's in few (1.6 rounds
+        // with a pop per far query, 0.17 per push: Puget Sound 1024², 64 directions, counted
+        // with a probe, since removed). Lazy pushes: 11 % fewer instructions, 0.985x the time.
         macro_rules! pop_while {
-            ($m:expr, $xq:expr, $yq:expr) => {{
+            ($m:expr, $xq:expr, $yq:expr, $eager:expr) => {{
                 let (m, xq, yq) = ($m, $xq, $yq);
-                let mut first = true;
+                let mut first = $eager;
                 loop {
                     let dx1 = _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xq));
                     let dx2 = _mm256_cvtepi32_ps(_mm256_sub_epi32(v2.x, xq));
@@ -401,7 +405,7 @@ impl HullsF32 {
         macro_rules! push {
             ($m:expr, $xq:expr, $yq:expr) => {{
                 let (m, xq, yq) = ($m, $xq, $yq);
-                pop_while!(m, xq, yq);
+                pop_while!(m, xq, yq, false);
                 record!(m, xq, yq);
             }};
         }
@@ -423,7 +427,7 @@ impl HullsF32 {
             }};
         }
         // 2. Far: the tangent from (τ_P, f_P).
-        pop_while!(on, xp, fp);
+        pop_while!(on, xp, fp, true);
         let dx_far = _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xp));
         let far = _mm256_add_ps(
             _mm256_mul_ps(
