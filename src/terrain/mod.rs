@@ -31,6 +31,7 @@ mod horizon_hull;
 mod horizon_hull_f32;
 pub mod horizon_map;
 mod horizon_quantise;
+mod horizon_records;
 pub mod horizon_sweep;
 pub use crate::heightmap::minmax_mipmap;
 pub mod relief;
