@@ -17,7 +17,7 @@
 //!    tangent. Every sample between P and m lies under the chord from P to m; where the far
 //!    tangent wins, every sample of the period and P′ lies under the chord from P to the far
 //!    tangent point: such a sample can be the tangent point of no pixel behind P, seen
-//!    through P (which step 3 of the next step considers as its P′). Of those from m on, a
+//!    through P (which the next step weighs as its P′). Of those from m on, a
 //!    sample under the chord from P, or from its left neighbour, to the last sample kept to
 //!    its right (the far tangent point before any) is skipped too: it lies under a segment
 //!    between two samples of the line, one on each side, so seen from any point further left
@@ -42,9 +42,10 @@
 //! **Layout of the AVX2 hulls.** Each push takes a slot (the same for every lane; a lane that
 //! does not push leaves it unused) that records, per lane, the vertex below the pushed one:
 //! the byte offset of its own record (so that a pop reads it with no arithmetic), its height
-//! and τ, as one 16-byte record. A lane's top two vertices live in registers; each pop round
-//! reads the third from the second one's record while it tests the top two (AVX2 has sixteen registers: a third vertex in them made the compiler spill the
-//! period loop's state, and reading it cost 2 % less than keeping it). The eight lanes'
+//! and τ, as one 16-byte record ([`super::horizon_records`]). A lane's top two vertices live
+//! in registers; each pop round reads the third from the second one's record while it tests
+//! the top two (AVX2 has sixteen registers: a third vertex in them made the compiler spill
+//! the period loop's state, and reading it cost 2 % less than keeping it). The eight lanes'
 //! records are eight 16-byte loads and a transpose: Zen 3 spends 39 µops on each eight-lane
 //! gather, and three gathers per pop round (one per field) took 17 % of a build; the records
 //! took 5–6 % off its user time (Puget Sound 1024², 64 directions). Pushes are four
