@@ -95,6 +95,16 @@ impl<'a> Plan<'a> {
             .log2()
             .floor()
             .clamp(0.0, 24.0);
+        let w = map.width as isize;
+        let tap = |s: &super::horizon::Stencil| Tap {
+            at: s.dy as isize * w + s.dx as isize,
+            tx: s.tx as f32,
+            ty: s.ty as f32,
+        };
+        let (taps, own_tap) = (
+            stencils.period.iter().map(tap).collect(),
+            tap(&stencils.own),
+        );
         let mut plan = Plan {
             map,
             dir: *dir,
@@ -110,25 +120,13 @@ impl<'a> Plan<'a> {
             avx2,
             offsets: Vec::new(),
             offsets_f: Vec::new(),
-            taps: Vec::new(),
-            own_tap: Tap {
-                at: 0,
-                tx: 0.0,
-                ty: 0.0,
-            },
+            taps,
+            own_tap,
             ahead: Vec::new(),
         };
         plan.offsets = plan.ts.iter().map(|&t| plan.fixed(t)).collect();
         plan.offsets_f = plan.offsets.iter().map(|&o| o as f32).collect();
-        let w = map.width as isize;
         let st = &plan.stencils;
-        let tap = |s: &super::horizon::Stencil| Tap {
-            at: s.dy as isize * w + s.dx as isize,
-            tx: s.tx as f32,
-            ty: s.ty as f32,
-        };
-        plan.taps = st.period.iter().map(tap).collect();
-        plan.own_tap = tap(&st.own);
         let back = AHEAD as isize * (dir.b as isize * w + dir.a as isize);
         plan.ahead = (st.lo[1]..=st.hi[1])
             .flat_map(|y| {
@@ -300,7 +298,6 @@ fn bundle_lanes(
             own_drop: (kappa * st.own.t * st.own.t) as f32,
             own_inv: (1.0 / st.own.t) as f32,
             next: plan.fixed(tau + plan.period_t) - xp,
-            dx_next: (plan.fixed(tau + plan.period_t) - xp) as f32,
             scale: plan.units as f32,
             shift: (2.0 * kappa * tau) as f32,
         };

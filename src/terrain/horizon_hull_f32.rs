@@ -74,10 +74,8 @@ pub(super) struct Step<'a> {
     pub near_inv: &'a [f32],
     pub own_drop: f32,
     pub own_inv: f32,
-    /// τ_P′ − τ_P in fixed point units (exact, and as f32), 2^F, and the curvature shift
-    /// 2κτ_P.
+    /// τ_P′ − τ_P in fixed point units, 2^F, and the curvature shift 2κτ_P.
     pub next: i32,
-    pub dx_next: f32,
     pub scale: f32,
     pub shift: f32,
 }
@@ -209,7 +207,7 @@ impl HullsF32 {
         // P′, the period's far end (index k), where it is on the map.
         let (prev_on, f_next) = (self.prev_on[j] != 0, self.f_prev[j]);
         if prev_on {
-            let v = (f_next - fp) / s.dx_next * s.scale + s.shift;
+            let v = (f_next - fp) / s.next as f32 * s.scale + s.shift;
             m = if v >= best { k } else { m };
             best = best.max(v);
         }
@@ -231,7 +229,13 @@ impl HullsF32 {
                     heights[i][j] + (zp - s.drop[i])
                 }
             };
-            let dx = |i: usize| if i == k { s.dx_next } else { s.offsets_f[i] };
+            let dx = |i: usize| {
+                if i == k {
+                    s.next as f32
+                } else {
+                    s.offsets_f[i]
+                }
+            };
             // The right end: the last sample kept, the far tangent point before any.
             for i in (m..=k).rev() {
                 if (i == k && !prev_on) || (i < k && i >= count) {
@@ -348,7 +352,7 @@ impl HullsF32 {
         let fp = _mm256_sub_ps(zp, _mm256_set1_ps(s.drop_p));
         let k = s.offsets.len();
         let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
-        let dx_next = _mm256_set1_ps(s.dx_next);
+        let dx_next = _mm256_set1_ps(s.next as f32);
         let slope_next = _mm256_add_ps(
             _mm256_mul_ps(
                 _mm256_div_ps(_mm256_sub_ps(f_next, fp), dx_next),
