@@ -105,7 +105,16 @@ impl<'a> Plan<'a> {
             stencils.period.iter().map(tap).collect(),
             tap(&stencils.own),
         );
-        let mut plan = Plan {
+        let units = 2f64.powi(bits as i32);
+        let offsets: Vec<i32> = ts.iter().map(|&t| fixed(t, units)).collect();
+        let st = &stencils;
+        let back = AHEAD as isize * (dir.b as isize * w + dir.a as isize);
+        let ahead = (st.lo[1]..=st.hi[1])
+            .flat_map(|y| {
+                [st.lo[0], LANES as i64 - 1 + st.hi[0]].map(|x| y as isize * w + x as isize - back)
+            })
+            .collect();
+        Plan {
             map,
             dir: *dir,
             track,
@@ -116,24 +125,14 @@ impl<'a> Plan<'a> {
             stencils,
             period_t,
             kappa,
-            units: 2f64.powi(bits as i32),
+            units,
             avx2,
-            offsets: Vec::new(),
-            offsets_f: Vec::new(),
+            offsets_f: offsets.iter().map(|&o| o as f32).collect(),
+            offsets,
             taps,
             own_tap,
-            ahead: Vec::new(),
-        };
-        plan.offsets = plan.ts.iter().map(|&t| plan.fixed(t)).collect();
-        plan.offsets_f = plan.offsets.iter().map(|&o| o as f32).collect();
-        let st = &plan.stencils;
-        let back = AHEAD as isize * (dir.b as isize * w + dir.a as isize);
-        plan.ahead = (st.lo[1]..=st.hi[1])
-            .flat_map(|y| {
-                [st.lo[0], LANES as i64 - 1 + st.hi[0]].map(|x| y as isize * w + x as isize - back)
-            })
-            .collect();
-        plan
+            ahead,
+        }
     }
 
     /// The steps n of the bundle starting at (r₀, x₀) whose lanes' stencils all lie on the
@@ -148,10 +147,15 @@ impl<'a> Plan<'a> {
         (rows.0.max(cols.0), rows.1.min(cols.1))
     }
 
-    /// τ ≥ 0 to the nearest fixed-point unit (halves up; no libm call).
+    /// τ ≥ 0 to the nearest fixed-point unit ([`fixed`]).
     fn fixed(&self, tau: f64) -> i32 {
-        (tau * self.units + 0.5) as i32
+        fixed(tau, self.units)
     }
+}
+
+/// τ ≥ 0 to the nearest of `units` per t (halves up; no libm call).
+fn fixed(tau: f64, units: f64) -> i32 {
+    (tau * units + 0.5) as i32
 }
 
 /// The n with lo ≤ n·q ≤ hi, as an interval (empty when its start exceeds its end).
