@@ -195,6 +195,17 @@ pub fn point_to_triangle(x: DVec3, n: DVec3, tri: [DVec3; 3], tn: DVec3) -> f64 
     (s / std::f64::consts::TAU).abs()
 }
 
+/// The incentre and inradius of the triangle `a b c` (inradius 0 for a degenerate one).
+pub fn incircle(a: DVec3, b: DVec3, c: DVec3) -> (DVec3, f64) {
+    let (la, lb, lc) = ((b - c).length(), (c - a).length(), (a - b).length());
+    let perimeter = la + lb + lc;
+    if perimeter <= 0.0 {
+        return (a, 0.0);
+    }
+    let centre = (a * la + b * lb + c * lc) / perimeter;
+    (centre, (b - a).cross(c - a).length() / perimeter)
+}
+
 /// A point drawn uniformly from the triangle `a b c` with `u, v` in [0, 1).
 pub fn point_in_triangle(a: DVec3, b: DVec3, c: DVec3, u: f64, v: f64) -> DVec3 {
     let su = u.sqrt();
@@ -270,6 +281,15 @@ impl AreaSampler {
     /// `u` chooses the fan triangle by area and, rescaled within that triangle's share, is the
     /// first coordinate inside it.
     pub fn sample_square(&self, u: f64, v: f64) -> (DVec3, DVec3) {
+        self.sample_square_inset(u, v, 0.0)
+    }
+
+    /// [`AreaSampler::sample_square`] in each fan triangle shrunk about its incentre so that its
+    /// edges move `inset` inwards (half its inradius where that is less): a ray origin drawn on
+    /// a patch's edge at a concave corner would otherwise lie, by the rounding of the grid's
+    /// f32 triangles, on either side of the adjoining wall, and a ray from outside it escapes
+    /// the scene.
+    pub fn sample_square_inset(&self, u: f64, v: f64, inset: f64) -> (DVec3, DVec3) {
         let k = self
             .cumulative
             .partition_point(|&c| c <= u)
@@ -282,7 +302,13 @@ impl AreaSampler {
             0.5
         };
         let (a, b, c, n) = self.triangles[k];
-        (point_in_triangle(a, b, c, w, v), n)
+        let p = point_in_triangle(a, b, c, w, v);
+        if inset <= 0.0 {
+            return (p, n);
+        }
+        let (centre, r) = incircle(a, b, c);
+        let d = inset.min(0.5 * r);
+        (centre + (p - centre) * (1.0 - d / r), n)
     }
 
     /// The point and normal at `select` (chooses the triangle by area) and `u, v` (inside it).
@@ -422,6 +448,37 @@ mod tests {
         ] {
             let (t, b) = basis(n);
             assert!(t.dot(n).abs() < 1e-12 && b.dot(n).abs() < 1e-12 && t.dot(b).abs() < 1e-12);
+        }
+    }
+
+    /// Distance from `p` to the line through `a` and `b`.
+    fn to_line(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+        (p - a).cross(b - a).length() / (b - a).length()
+    }
+
+    proptest::proptest! {
+        /// Inset samples keep `min(inset, r/2)` from every edge line of their fan triangle
+        /// (brute-force distances, 1e-9 relative margin for f64 rounding) and stay in its plane.
+        #[test]
+        fn inset_samples_keep_off_the_edges(
+            b in (0.01f64..3.0, -2.0f64..2.0),
+            c in (-2.0f64..2.0, 1e-6f64..2.0),
+            u in 0.0f64..1.0, v in 0.0f64..1.0, inset in 1e-7f64..0.5,
+        ) {
+            let (a, b, c) = (DVec3::ZERO, DVec3::new(b.0, b.1, 0.0), DVec3::new(c.0, c.1, 0.0));
+            let s = AreaSampler::new([(&[a, b, c][..], DVec3::Z)]);
+            let (p, n) = s.sample_square_inset(u, v, inset);
+            let r = 2.0 * area(&[a, b, c]) / ((b - a).length() + (c - b).length() + (a - c).length());
+            let d = inset.min(0.5 * r);
+            proptest::prop_assert_eq!(n, DVec3::Z);
+            proptest::prop_assert_eq!(p.z, 0.0);
+            let inside = (b - a).cross(p - a).z.signum() == (c - b).cross(p - b).z.signum()
+                && (c - b).cross(p - b).z.signum() == (a - c).cross(p - c).z.signum();
+            proptest::prop_assert!(inside, "{p:?} outside");
+            for (e0, e1) in [(a, b), (b, c), (c, a)] {
+                let dist = to_line(p, e0, e1);
+                proptest::prop_assert!(dist >= d * (1.0 - 1e-9), "{dist} < {d}");
+            }
         }
     }
 

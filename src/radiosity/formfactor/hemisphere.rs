@@ -1,7 +1,8 @@
 //! Hemisphere shooting: from each patch, N rays with origins stratified over the patch's area and
 //! cosine-distributed directions about the local surface normal; `F_ij ≈ hits_j / N`. Rays start
-//! a ray epsilon above the surface (never on it), so a ray leaving a concave corner hits the
-//! adjoining wall instead of slipping out behind it.
+//! a ray epsilon above the surface (never on it) and a ray epsilon in from the patch's edges
+//! (never on the adjoining wall's plane), so a ray leaving a concave corner hits the adjoining
+//! wall instead of slipping out behind it.
 //!
 //! A cosine-distributed direction has density cosθ/π, which is exactly the form-factor kernel of
 //! a differential area, so each hit counts 1/N (Malley's method). Origins (over the patch's
@@ -61,7 +62,7 @@ pub fn estimate_rows(
 }
 
 /// The `k` rays patch `i` shoots (grid coordinates): origins lifted one ray epsilon off the
-/// surface, unit cosine-distributed directions; empty for a patch without area. Exactly the
+/// surface and kept one in from its edges, unit cosine-distributed directions; empty for a patch without area. Exactly the
 /// rays [`shoot`] traces (an independent tracer can be given the same ones).
 pub fn rays(ctx: &Context, i: usize, k: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
     let sampler = &ctx.samplers[i];
@@ -74,7 +75,7 @@ pub fn rays(ctx: &Context, i: usize, k: usize, seed: u64) -> Vec<(DVec3, DVec3)>
     let lift = ctx.vis.epsilon as f64;
     (0..k)
         .map(|s| {
-            let (origin, normal) = sampler.sample_square(origins[s].0, origins[s].1);
+            let (origin, normal) = sampler.sample_square_inset(origins[s].0, origins[s].1, lift);
             let dir = cosine_direction(normal, directions[s].0, directions[s].1);
             (origin + normal * lift, dir)
         })

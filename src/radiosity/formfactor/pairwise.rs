@@ -107,7 +107,8 @@ pub fn points_per_patch(samples: usize) -> usize {
 
 /// One visibility ray of a patch pair: point `a` on i to point `b` on j, its kernel weight
 /// `cosθ_x cosθ_y / (π r² + ΔA)`, and the segment tested for occlusion (both ends lifted off
-/// their surfaces by the ray epsilon along their normals).
+/// their surfaces by the ray epsilon along their normals; the points keep one ray epsilon in
+/// from their patches' edges).
 #[derive(Clone, Copy, Debug)]
 pub struct PairRay {
     pub a: usize,
@@ -127,10 +128,10 @@ pub fn pair_rays(ctx: &Context, i: usize, j: usize, k: usize, seed: u64) -> Pair
     }
     let m = points_per_patch(k);
     let mut rng = item_rng(seed, i as u64, j as u64);
-    let xs = points(si, m, &mut rng);
-    let ys = points(sj, m, &mut rng);
-    let disc = (si.area + sj.area) / (2.0 * (m * m) as f64);
     let lift = ctx.vis.epsilon as f64;
+    let xs = points(si, m, lift, &mut rng);
+    let ys = points(sj, m, lift, &mut rng);
+    let disc = (si.area + sj.area) / (2.0 * (m * m) as f64);
     let mut rays = Vec::with_capacity(m * m);
     for (a, (x, nx)) in xs.iter().enumerate() {
         for (b, (y, ny)) in ys.iter().enumerate() {
@@ -216,9 +217,11 @@ fn side(pts: &[(DVec3, DVec3)], vis: &[(f64, f64)], area: f64, target: &AreaSamp
     (mean, var)
 }
 
-fn points(s: &AreaSampler, k: usize, rng: &mut Rng) -> Vec<(DVec3, DVec3)> {
+/// `k` stratified points of `s`, kept `inset` in from its edges (see
+/// [`AreaSampler::sample_square_inset`]).
+fn points(s: &AreaSampler, k: usize, inset: f64, rng: &mut Rng) -> Vec<(DVec3, DVec3)> {
     rng.jittered(k)
         .into_iter()
-        .map(|(u, v)| s.sample_square(u, v))
+        .map(|(u, v)| s.sample_square_inset(u, v, inset))
         .collect()
 }
