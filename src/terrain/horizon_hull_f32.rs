@@ -309,11 +309,11 @@ impl HullsF32 {
     /// order (no FMA).
     ///
     /// # Safety
-    /// AVX2 must be available; `below` must have room for k + 1 more slots, and the slices of
+    /// AVX2 must be available (the caller an AVX2 or wider `#[target_feature]` entry point, into
+    /// which this inlines); `below` must have room for k + 1 more slots, and the slices of
     /// `s` and `heights` at least k entries (k = `s.offsets.len()`). (A count over k, or
     /// negative, would give wrong slopes but read nothing out of bounds: counts only mask.)
-    #[target_feature(enable = "avx2")]
-    #[inline]
+    #[inline(always)]
     unsafe fn step_avx2(
         &mut self,
         s: &Step,

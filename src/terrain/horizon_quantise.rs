@@ -51,10 +51,10 @@ pub(super) fn quantise_lanes(slopes: &[f32; LANES], inv_m: f32, avx2: bool) -> [
 /// [`quantise`] on eight lanes: [`atan_f32`]'s selects as blends, then [`step_of`].
 ///
 /// # Safety
-/// AVX2 must be available.
+/// AVX2 must be available (the caller an AVX2 or wider `#[target_feature]` entry point, into which
+/// this inlines).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
+#[inline(always)]
 unsafe fn quantise_avx2(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
     use std::arch::x86_64::*;
     let f = _mm256_set1_ps;

@@ -7,8 +7,7 @@ use super::horizon_hull::LANES;
 
 /// The least of eight i32 lanes.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
+#[inline(always)]
 pub(super) unsafe fn min_lane(v: std::arch::x86_64::__m256i) -> i32 {
     use std::arch::x86_64::*;
     let m = _mm_min_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
@@ -38,10 +37,10 @@ pub(super) const WITHIN: [i32; LANES] = [0, 32, 64, 96, 16, 48, 80, 112];
 /// so lane j's record starts at byte 32·(j mod 4) + 16·(j div 4).
 ///
 /// # Safety
-/// AVX2 must be available; `to` must have room for `LANES * RECORD` i32.
+/// AVX2 must be available (the caller an AVX2 or wider `#[target_feature]` entry point, into which
+/// this inlines); `to` must have room for `LANES * RECORD` i32.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
+#[inline(always)]
 pub(super) unsafe fn store_records(to: *mut i32, v: Top) {
     use std::arch::x86_64::*;
     let y = _mm256_castps_si256(v.y);
@@ -65,11 +64,11 @@ pub(super) unsafe fn store_records(to: *mut i32, v: Top) {
 /// on Zen 3).
 ///
 /// # Safety
-/// AVX2 must be available; each lane's offset must address a whole record within `base`'s
+/// AVX2 must be available (the caller an AVX2 or wider `#[target_feature]` entry point, into which
+/// this inlines); each lane's offset must address a whole record within `base`'s
 /// buffer.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
+#[inline(always)]
 pub(super) unsafe fn load_records(base: *const i32, at: std::arch::x86_64::__m256i) -> Top {
     use std::arch::x86_64::*;
     let mut off = [0u32; LANES];
@@ -91,8 +90,7 @@ pub(super) unsafe fn load_records(base: *const i32, at: std::arch::x86_64::__m25
 
 /// `b` in the lanes of mask `m`, else `a`.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
+#[inline(always)]
 pub(super) unsafe fn pick(a: Top, b: Top, m: std::arch::x86_64::__m256i) -> Top {
     use std::arch::x86_64::*;
     Top {

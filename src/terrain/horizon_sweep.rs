@@ -135,10 +135,10 @@ impl Sweeper<'_> {
             (map, t)
         });
         let n = map.width * map.height;
-        let avx2 = crate::cpu::has_avx2();
+        let simd = crate::cpu::Simd::detect();
         if dir.a.abs() <= dir.b.abs() {
             let mut plane = vec![0u16; n];
-            super::horizon_f32::sweep_steep_u16(map, dir, planet_radius, avx2, atomics(&mut plane));
+            super::horizon_f32::sweep_steep_u16(map, dir, planet_radius, simd, atomics(&mut plane));
             return plane;
         }
         let mirrored = Direction {
@@ -148,7 +148,7 @@ impl Sweeper<'_> {
         };
         scratch.clear();
         scratch.resize(n, 0);
-        super::horizon_f32::sweep_steep_u16(t, &mirrored, planet_radius, avx2, atomics(scratch));
+        super::horizon_f32::sweep_steep_u16(t, &mirrored, planet_radius, simd, atomics(scratch));
         transpose_map(scratch, t.width, t.height, |&v| v)
     }
 }
