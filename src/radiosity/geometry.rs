@@ -307,6 +307,9 @@ impl AreaSampler {
             return (p, n);
         }
         let (centre, r) = incircle(a, b, c);
+        if r <= 0.0 {
+            return (p, n);
+        }
         let d = inset.min(0.5 * r);
         (centre + (p - centre) * (1.0 - d / r), n)
     }

@@ -70,9 +70,8 @@ struct Plan<'a> {
     /// The texel offsets from a step's lane-0 pixel of the two ends of each row its stencils
     /// read, [`AHEAD`] steps further on ([`prefetch`]).
     ahead: Vec<isize>,
-    /// The level the bundles run at, and whether it has AVX2 (what the kernels inside ask).
+    /// The level the bundles run at.
     simd: Simd,
-    avx2: bool,
 }
 
 /// A stencil in f32 ([`eval_f32`]): its top-left tap's offset from the pixel in the map's
@@ -130,7 +129,6 @@ impl<'a> Plan<'a> {
             kappa,
             units,
             simd,
-            avx2: simd >= Simd::Avx2,
             offsets_f: offsets.iter().map(|&o| o as f32).collect(),
             offsets,
             taps,
@@ -149,6 +147,12 @@ impl<'a> Plan<'a> {
         let rows = steps_within(-st.lo[1] - r0, h - 1 - st.hi[1] - r0, b);
         let cols = steps_within(-st.lo[0] - x0, w - LANES as i64 - st.hi[0] - x0, a);
         (rows.0.max(cols.0), rows.1.min(cols.1))
+    }
+
+    /// Whether the bundles run the AVX2 kernels (at [`Simd::Avx2`] or wider).
+    #[inline(always)]
+    fn avx2(&self) -> bool {
+        self.simd >= Simd::Avx2
     }
 
     /// τ ≥ 0 to the nearest fixed-point unit ([`fixed`]).
@@ -333,8 +337,8 @@ fn bundle_lanes(
             scale: plan.units as f32,
             shift: (2.0 * kappa * tau) as f32,
         };
-        let slopes = sc.hulls.step(&step, &input, heights, plan.avx2);
-        let q = quantise_lanes(&slopes, inv_m, plan.avx2);
+        let slopes = sc.hulls.step(&step, &input, heights, plan.avx2());
+        let q = quantise_lanes(&slopes, inv_m, plan.avx2());
         let first = base as usize;
         if all_fit {
             // Every lane's pixel is on the map: one store of the eight texels, which no
@@ -412,7 +416,7 @@ fn eval_lanes(
 ) {
     let (hs, w) = (&plan.map.heights[..], plan.map.width);
     #[cfg(target_arch = "x86_64")]
-    if plan.avx2 {
+    if plan.avx2() {
         // Every tap of every lane on the map (the caller's test), checked once for the box.
         let st = &plan.stencils;
         let lo = base as isize + st.lo[1] as isize * w as isize + st.lo[0] as isize;

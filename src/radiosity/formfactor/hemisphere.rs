@@ -62,8 +62,9 @@ pub fn estimate_rows(
 }
 
 /// The `k` rays patch `i` shoots (grid coordinates): origins lifted one ray epsilon off the
-/// surface and kept one in from its edges, unit cosine-distributed directions; empty for a patch without area. Exactly the
-/// rays [`shoot`] traces (an independent tracer can be given the same ones).
+/// surface and kept one in from its edges, unit cosine-distributed directions; empty for a
+/// patch without area. Exactly the rays [`shoot`] traces (an independent tracer can be given
+/// the same ones).
 pub fn rays(ctx: &Context, i: usize, k: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
     let sampler = &ctx.samplers[i];
     if sampler.is_empty() {
