@@ -26,7 +26,7 @@ fn random_light(r: &mut Rng) -> GpuLight {
         _ => {
             let inner = uniform(r, 0.0, 1.0);
             // A quarter of the spots have equal cones (a hard step).
-            let outer = if r.next_u32() % 4 == 0 {
+            let outer = if r.next_u32().is_multiple_of(4) {
                 inner
             } else {
                 inner + uniform(r, 0.02, 0.5)
@@ -52,7 +52,7 @@ fn random_light(r: &mut Rng) -> GpuLight {
         ),
         uniform(r, 0.1, 4.0),
     );
-    if r.next_u32() % 2 == 0 {
+    if r.next_u32().is_multiple_of(2) {
         l.range = Some(uniform(r, 0.5, 5.0));
     }
     GpuLight::from_light(&l, 1.0, 0)
@@ -214,7 +214,13 @@ fn point_face_matches_its_rust_twin_including_ties() {
         // Ties between two random axes with random signs.
         let a = uniform(&mut r, 0.1, 2.0);
         let b = uniform(&mut r, 0.0, a);
-        let s = |r: &mut Rng| if r.next_u32() % 2 == 0 { 1.0 } else { -1.0 };
+        let s = |r: &mut Rng| {
+            if r.next_u32().is_multiple_of(2) {
+                1.0
+            } else {
+                -1.0
+            }
+        };
         let v = [a * s(&mut r), a * s(&mut r), b * s(&mut r)];
         let k = (r.next_u32() % 3) as usize;
         dirs.push(Vec3::new(v[k], v[(k + 1) % 3], v[(k + 2) % 3]));

@@ -70,7 +70,7 @@ pub fn encode_image(
     texel: impl Fn(usize, usize) -> [u8; 3] + Sync,
 ) -> Vec<u8> {
     assert!(
-        width % 4 == 0 && height % 4 == 0,
+        width.is_multiple_of(4) && height.is_multiple_of(4),
         "BC1 image size must be a multiple of 4"
     );
     let bw = width / 4;

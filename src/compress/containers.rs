@@ -52,7 +52,7 @@ pub struct Tile {
 
 /// Cut a `padded`-wide texture into tiles of at most `max_size` per side.
 pub fn plan_tiles(padded: usize, max_size: usize, stem: &str) -> Result<Vec<Tile>> {
-    if max_size < 4 || max_size % 4 != 0 {
+    if max_size < 4 || !max_size.is_multiple_of(4) {
         return Err(Error::knob(format!(
             "max_texture_size {max_size} must be a positive multiple of 4"
         )));

@@ -202,7 +202,10 @@ pub(super) fn restrict(field: &Field, lo: [f64; 3], hi: [f64; 3]) -> Field {
 }
 
 fn is_prime(n: u64) -> bool {
-    n >= 2 && (2..).take_while(|d| d * d <= n).all(|d| n % d != 0)
+    n >= 2
+        && (2..)
+            .take_while(|d| d * d <= n)
+            .all(|d| !n.is_multiple_of(d))
 }
 
 pub(super) fn bits(m: u8) -> [u32; 3] {

@@ -72,7 +72,7 @@ pub fn reorder_passes(v: u8) -> Result<u8, String> {
 
 /// A texture side: a multiple of 4, at least 4.
 pub fn texture_size(v: u32) -> Result<u32, String> {
-    if v >= 4 && v % 4 == 0 {
+    if v >= 4 && v.is_multiple_of(4) {
         Ok(v)
     } else {
         Err(format!(

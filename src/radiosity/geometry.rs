@@ -48,7 +48,7 @@ pub fn dominant_axis(n: DVec3) -> u8 {
 /// The unit vector of a dominant-axis index.
 pub fn axis_vector(axis: u8) -> DVec3 {
     let mut v = DVec3::ZERO;
-    v[(axis / 2) as usize] = if axis % 2 == 0 { 1.0 } else { -1.0 };
+    v[(axis / 2) as usize] = if axis.is_multiple_of(2) { 1.0 } else { -1.0 };
     v
 }
 

@@ -39,7 +39,6 @@
 //! ~1e-9°.
 
 use super::exact_traversal::{texel_sample, TrackWalk};
-use super::horizon_hull::LANES;
 use super::sun::{Track, TrackKind};
 use crate::heightmap::HeightMap;
 
@@ -326,9 +325,13 @@ impl Stencils {
 }
 
 /// The bundles of direction (a, b) (|b| ≥ |a|) over `map`: (r₀, x₀, n₀, n₁) for each bundle
-/// of [`LANES`] lines starting at row r₀ and column x₀ with some lane on the map for steps
+/// of `lanes` lines starting at row r₀ and column x₀ with some lane on the map for steps
 /// n₀ ..= n₁ (module notes: virtual lines).
-pub(super) fn bundle_list(map: &HeightMap, dir: &Direction) -> Vec<(i64, i64, i64, i64)> {
+pub(super) fn bundle_list(
+    map: &HeightMap,
+    dir: &Direction,
+    lanes: usize,
+) -> Vec<(i64, i64, i64, i64)> {
     let (w, h) = (map.width as i64, map.height as i64);
     let (a, b) = (dir.a, dir.b);
     // The first rows of the lines (n = 0), on the side the walk ends at.
@@ -345,8 +348,8 @@ pub(super) fn bundle_list(map: &HeightMap, dir: &Direction) -> Vec<(i64, i64, i6
         } else {
             (0, w - 1 - n_max * a)
         };
-        for x0 in (lo..=hi).step_by(LANES) {
-            if let Some((n0, n1)) = active_span(x0, a, w, n_max) {
+        for x0 in (lo..=hi).step_by(lanes) {
+            if let Some((n0, n1)) = active_span(x0, a, w, n_max, lanes) {
                 bundles.push((r0, x0, n0, n1));
             }
         }
@@ -355,10 +358,10 @@ pub(super) fn bundle_list(map: &HeightMap, dir: &Direction) -> Vec<(i64, i64, i6
 }
 
 /// The steps n ∈ [0, n_max] at which some lane of the bundle at column x₀ is on the map
-/// (0 ≤ x₀ + j + n·a < w for some j < LANES), or None.
-fn active_span(x0: i64, a: i64, w: i64, n_max: i64) -> Option<(i64, i64)> {
+/// (0 ≤ x₀ + j + n·a < w for some j < `lanes`), or None.
+fn active_span(x0: i64, a: i64, w: i64, n_max: i64, lanes: usize) -> Option<(i64, i64)> {
     // n·a must lie in [lo, hi].
-    let (lo, hi) = (-(LANES as i64 - 1) - x0, w - 1 - x0);
+    let (lo, hi) = (-(lanes as i64 - 1) - x0, w - 1 - x0);
     let (n0, n1) = match a.signum() {
         0 if lo <= 0 && 0 <= hi => (0, n_max),
         0 => return None,

@@ -54,10 +54,9 @@
 //! branch on whether any lane does, taken about two times in three, mispredicted at a cost
 //! higher than the pushes it saved.
 
-use super::horizon_hull::LANES;
 #[cfg(target_arch = "x86_64")]
-use super::horizon_records::{load_records, min_lane, pick, store_records, Top};
-use super::horizon_records::{RECORD, WITHIN};
+use super::horizon_lanes::{pick, Lanes, Top};
+use super::horizon_lanes::{within, RECORD};
 
 /// What every lane of one pixel step shares (module notes; `s` indexes the period's samples,
 /// nearest first).
@@ -84,53 +83,53 @@ pub(super) struct Step<'a> {
 /// [`HullsF32::step`]: the period samples' heights less P's, [s][lane]; a lane has its first
 /// `count[lane]` (near the map's edge, the walk's samples stop there), and −∞ after them where
 /// its pixel is on the map).
-pub(super) struct LaneInput {
-    pub count: [i32; LANES],
+pub(super) struct LaneInput<const N: usize> {
+    pub count: [i32; N],
     /// The own texel's half transit (less P's height) and P's height.
-    pub own: [f32; LANES],
-    pub zp: [f32; LANES],
+    pub own: [f32; N],
+    pub zp: [f32; N],
     /// −1 where the lane's pixel is on the map, 0 where not.
-    pub on: [i32; LANES],
+    pub on: [i32; N],
 }
 
 /// The hulls of one bundle's lanes.
-pub(super) struct HullsF32 {
+pub(super) struct HullsF32<const N: usize> {
     // AVX2 layout: per slot and lane, the vertex below the one pushed there, as a record
     // [at, y bits, x, x] of four i32 (`RECORD`; `at` is the byte offset of the vertex's own
     // record, `Top`); a slot's eight records in lane order
     // 0, 4, 1, 5, 2, 6, 3, 7 (`store_records`).
     below: Vec<i32>,
     slot: usize,
-    top: [[i32; LANES]; 2],
-    top_y: [[f32; LANES]; 2],
-    top_x: [[i32; LANES]; 2],
+    top: [[i32; N]; 2],
+    top_y: [[f32; N]; 2],
+    top_x: [[i32; N]; 2],
     // Portable layout: a stack per lane.
-    stacks: [LaneStack; LANES],
+    stacks: [LaneStack; N],
     /// f_P′ of the previous step, and where its pixel was on the map.
-    f_prev: [f32; LANES],
-    prev_on: [i32; LANES],
+    f_prev: [f32; N],
+    prev_on: [i32; N],
 }
 
-impl HullsF32 {
-    pub fn new() -> HullsF32 {
+impl<const N: usize> HullsF32<N> {
+    pub fn new() -> Self {
         HullsF32 {
             below: Vec::new(),
             slot: 1,
-            top: [[0; LANES]; 2],
-            top_y: [[0.0; LANES]; 2],
-            top_x: [[0; LANES]; 2],
+            top: [[0; N]; 2],
+            top_y: [[0.0; N]; 2],
+            top_x: [[0; N]; 2],
             stacks: std::array::from_fn(|_| LaneStack {
                 buf: Vec::new(),
                 len: 0,
             }),
-            f_prev: [0.0; LANES],
-            prev_on: [0; LANES],
+            f_prev: [0.0; N],
+            prev_on: [0; N],
         }
     }
 
     /// Empty every lane, with room for `pushes` pushes of the AVX2 path.
     pub fn reset(&mut self, pushes: usize) {
-        let n = (pushes + 1) * LANES * RECORD;
+        let n = (pushes + 1) * N * RECORD;
         // A record's byte offset is an i32 lane.
         assert!(n * 4 <= i32::MAX as usize, "a bundle of {pushes} pushes");
         if self.below.len() < n {
@@ -138,7 +137,7 @@ impl HullsF32 {
         }
         // Slot 0 is the empty hull's sentinel (slot 0 below slot 0): each of its records
         // points at itself.
-        for (i, r) in self.below[..LANES * RECORD]
+        for (i, r) in self.below[..N * RECORD]
             .chunks_exact_mut(RECORD)
             .enumerate()
         {
@@ -146,42 +145,24 @@ impl HullsF32 {
             r[0] = (i * RECORD * 4) as i32;
         }
         self.slot = 1;
-        self.top = [WITHIN; 2];
-        self.top_y = [[0.0; LANES]; 2];
-        self.top_x = [[0; LANES]; 2];
+        self.top = [within::<N>(); 2];
+        self.top_y = [[0.0; N]; 2];
+        self.top_x = [[0; N]; 2];
         for f in &mut self.stacks {
             if f.buf.len() < pushes + 2 {
                 f.buf.resize(pushes + 2, (0, 0.0));
             }
             f.len = 0;
         }
-        self.prev_on = [0; LANES];
+        self.prev_on = [0; N];
     }
 
-    /// One pixel step of every lane; returns each lane's slope (t units; anything for lanes
-    /// off the map). With `avx2` (detected by the caller) the AVX2 kernel, else the portable
-    /// one: the same bits. A bundle must use one of them throughout.
+    /// One pixel step of every lane in the portable kernel; returns each lane's slope (t
+    /// units; anything for lanes off the map). The same bits as [`HullsF32::step_simd`]; a
+    /// bundle must use one of them throughout.
     #[inline(always)]
-    pub fn step(
-        &mut self,
-        s: &Step,
-        l: &LaneInput,
-        heights: &[[f32; LANES]],
-        avx2: bool,
-    ) -> [f32; LANES] {
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            let k = s.offsets.len();
-            assert!(self.below.len() >= (self.slot + k + 1) * LANES * RECORD);
-            assert!(heights.len() >= k && s.drop.len() >= k && s.offsets_f.len() >= k);
-            assert!(s.near_drop.len() >= k && s.near_inv.len() >= k);
-            // The counts only mask lanes (no load depends on them): a check for debug builds.
-            debug_assert!(counts_within(&l.count, k));
-            // SAFETY: AVX2 was detected; the asserts above give the slots and the lengths.
-            return unsafe { self.step_avx2(s, l, heights) };
-        }
-        let _ = avx2;
-        let mut out = [0.0; LANES];
+    pub fn step(&mut self, s: &Step, l: &LaneInput<N>, heights: &[[f32; N]]) -> [f32; N] {
+        let mut out = [0.0; N];
         for (j, o) in out.iter_mut().enumerate() {
             if l.on[j] != 0 {
                 *o = self.step_lane(s, l, heights, j);
@@ -194,7 +175,7 @@ impl HullsF32 {
 
     /// Lane j's step (module notes, steps 1–3): the portable kernel.
     #[inline(always)]
-    fn step_lane(&mut self, s: &Step, l: &LaneInput, heights: &[[f32; LANES]], j: usize) -> f32 {
+    fn step_lane(&mut self, s: &Step, l: &LaneInput<N>, heights: &[[f32; N]], j: usize) -> f32 {
         let (zp, count, k) = (l.zp[j], l.count[j] as usize, s.offsets.len());
         let mut near = (l.own[j] - s.own_drop) * s.own_inv;
         let (mut best, mut m) = (f32::NEG_INFINITY, 0usize);
@@ -266,7 +247,7 @@ impl HullsF32 {
 
 /// Whether every lane's count lies in 0..=k.
 #[inline(always)]
-fn counts_within(count: &[i32; LANES], k: usize) -> bool {
+fn counts_within<const N: usize>(count: &[i32; N], k: usize) -> bool {
     let k = k as i32;
     count.iter().fold(true, |ok, &c| ok & (c >= 0) & (c <= k))
 }
@@ -304,81 +285,88 @@ impl LaneStack {
 }
 
 #[cfg(target_arch = "x86_64")]
-impl HullsF32 {
-    /// [`HullsF32::step_lane`] for all eight lanes at once, the same operations in the same
-    /// order (no FMA).
+impl<const N: usize> HullsF32<N> {
+    /// [`HullsF32::step_lane`] for all N lanes at once in the vector operations of `V`
+    /// ([`Lanes`]), the same operations in the same order (no FMA): the same bits as
+    /// [`HullsF32::step`].
     ///
     /// # Safety
-    /// AVX2 must be available (the caller an AVX2 or wider `#[target_feature]` entry point, into
-    /// which this inlines); `below` must have room for k + 1 more slots, and the slices of
-    /// `s` and `heights` at least k entries (k = `s.offsets.len()`). (A count over k, or
-    /// negative, would give wrong slopes but read nothing out of bounds: counts only mask.)
+    /// The CPU must have `V`'s features (the caller an entry point compiled for them, into
+    /// which this inlines). (A count over k, or negative, would give wrong slopes but read
+    /// nothing out of bounds: counts only mask.)
     #[inline(always)]
-    unsafe fn step_avx2(
+    pub unsafe fn step_simd<V: Lanes<N>>(
         &mut self,
         s: &Step,
-        l: &LaneInput,
-        heights: &[[f32; LANES]],
-    ) -> [f32; LANES] {
-        use std::arch::x86_64::*;
-        let ld_i = |a: &[i32; LANES]| _mm256_loadu_si256(a.as_ptr() as *const __m256i);
-        let ld_f = |a: &[f32; LANES]| _mm256_loadu_ps(a.as_ptr());
-        let zero = _mm256_setzero_si256();
-        let (zp, on, count) = (ld_f(&l.zp), ld_i(&l.on), ld_i(&l.count));
+        l: &LaneInput<N>,
+        heights: &[[f32; N]],
+    ) -> [f32; N] {
+        let k = s.offsets.len();
+        assert!(self.below.len() >= (self.slot + k + 1) * N * RECORD);
+        assert!(heights.len() >= k && s.drop.len() >= k && s.offsets_f.len() >= k);
+        assert!(s.near_drop.len() >= k && s.near_inv.len() >= k);
+        // The counts only mask lanes (no load depends on them): a check for debug builds.
+        debug_assert!(counts_within(&l.count, k));
+        // Macros, not closures, for what calls `V`: a closure is compiled without the entry
+        // point's features, and the intrinsics in it were not inlined (3x slower).
+        macro_rules! ld_i {
+            ($a:expr) => {
+                V::load_i($a.as_ptr())
+            };
+        }
+        macro_rules! ld_f {
+            ($a:expr) => {
+                V::load_f($a.as_ptr())
+            };
+        }
+        let (sf, si) = (V::splat_f, V::splat_i);
+        let (zp, count) = (ld_f!(l.zp), ld_i!(l.count));
+        let on = V::mask_of(ld_i!(l.on));
         // 1. Near; the period's largest slope and its last index.
-        let mut near = _mm256_mul_ps(
-            _mm256_sub_ps(ld_f(&l.own), _mm256_set1_ps(s.own_drop)),
-            _mm256_set1_ps(s.own_inv),
-        );
-        let mut best = _mm256_set1_ps(f32::NEG_INFINITY);
-        let mut argmax = zero;
+        let mut near = V::mul(V::sub(ld_f!(l.own), sf(s.own_drop)), sf(s.own_inv));
+        let mut best = sf(f32::NEG_INFINITY);
+        let mut argmax = si(0);
         // A lane's samples past its count are −∞ (`heights`, [`LaneInput`]): they never reach
         // `best`, nor move `argmax` once a sample has (where none has, `best` stays −∞ and the
         // lane pushes nothing).
-        for i in 0..s.offsets.len() {
-            let v = _mm256_mul_ps(
-                _mm256_sub_ps(
-                    ld_f(heights.get_unchecked(i)),
-                    _mm256_set1_ps(*s.near_drop.get_unchecked(i)),
+        for i in 0..k {
+            let v = V::mul(
+                V::sub(
+                    ld_f!(heights.get_unchecked(i)),
+                    sf(*s.near_drop.get_unchecked(i)),
                 ),
-                _mm256_set1_ps(*s.near_inv.get_unchecked(i)),
+                sf(*s.near_inv.get_unchecked(i)),
             );
-            let ge = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(v, best));
-            argmax = _mm256_blendv_epi8(argmax, _mm256_set1_epi32(i as i32), ge);
-            best = _mm256_max_ps(best, v);
+            argmax = V::blend_i(argmax, si(i as i32), V::ge(v, best));
+            best = V::max(best, v);
         }
         // P′, the period's far end (index k), where it is on the map.
-        let xp = _mm256_set1_epi32(s.xp);
-        let fp = _mm256_sub_ps(zp, _mm256_set1_ps(s.drop_p));
-        let k = s.offsets.len();
-        let (f_next, prev_on) = (ld_f(&self.f_prev), ld_i(&self.prev_on));
-        let dx_next = _mm256_set1_ps(s.next as f32);
-        let slope_next = _mm256_add_ps(
-            _mm256_mul_ps(
-                _mm256_div_ps(_mm256_sub_ps(f_next, fp), dx_next),
-                _mm256_set1_ps(s.scale),
-            ),
-            _mm256_set1_ps(s.shift),
+        let xp = si(s.xp);
+        let fp = V::sub(zp, sf(s.drop_p));
+        let (f_next, prev_on) = (ld_f!(self.f_prev), V::mask_of(ld_i!(self.prev_on)));
+        let dx_next = sf(s.next as f32);
+        let slope_next = V::add(
+            V::mul(V::div(V::sub(f_next, fp), dx_next), sf(s.scale)),
+            sf(s.shift),
         );
-        let slope_next = _mm256_blendv_ps(
-            _mm256_set1_ps(f32::NEG_INFINITY),
-            slope_next,
-            _mm256_castsi256_ps(prev_on),
-        );
-        let ge = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GE_OQ>(slope_next, best));
-        argmax = _mm256_blendv_epi8(argmax, _mm256_set1_epi32(k as i32), ge);
-        best = _mm256_max_ps(best, slope_next);
-        near = _mm256_max_ps(near, best);
+        let slope_next = V::blend_f(sf(f32::NEG_INFINITY), slope_next, prev_on);
+        argmax = V::blend_i(argmax, si(k as i32), V::ge(slope_next, best));
+        best = V::max(best, slope_next);
+        near = V::max(near, best);
         // The top two vertices of every lane: record, height, τ.
-        let top = |k: usize| Top {
-            at: ld_i(&self.top[k]),
-            y: ld_f(&self.top_y[k]),
-            x: ld_i(&self.top_x[k]),
-        };
-        let (mut v1, mut v2) = (top(0), top(1));
+        macro_rules! top {
+            ($k:expr) => {
+                Top::<V, N> {
+                    at: ld_i!(self.top[$k]),
+                    y: ld_f!(self.top_y[$k]),
+                    x: ld_i!(self.top_x[$k]),
+                }
+            };
+        }
+        let (mut v1, mut v2) = (top!(0), top!(1));
         let below = self.below.as_mut_ptr();
-        // Each lane's record within a slot, in bytes (`store_records`): the sentinel's.
-        let within = ld_i(&WITHIN);
+        // Each lane's record within a slot, in bytes (`Lanes::store_records`): the sentinel's.
+        let within = V::within();
         // Pop, in the lanes of mask m, while the top vertex fails the test against (xq, yq).
         // With `eager`, the first round reads the third vertex before its test's branch: the
         // far query's first round pops somewhere in most steps, a push's in few (1.6 rounds
@@ -389,22 +377,19 @@ impl HullsF32 {
                 let (m, xq, yq) = ($m, $xq, $yq);
                 let mut first = $eager;
                 loop {
-                    let dx1 = _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xq));
-                    let dx2 = _mm256_cvtepi32_ps(_mm256_sub_epi32(v2.x, xq));
-                    let l = _mm256_mul_ps(_mm256_sub_ps(v1.y, yq), dx2);
-                    let r = _mm256_mul_ps(_mm256_sub_ps(v2.y, yq), dx1);
-                    let deep = _mm256_andnot_si256(_mm256_cmpeq_epi32(v2.at, within), m);
-                    let pop = _mm256_and_si256(
-                        deep,
-                        _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OQ>(l, r)),
-                    );
-                    if !first && _mm256_testz_si256(pop, pop) != 0 {
+                    let dx1 = V::to_f(V::sub_i(v1.x, xq));
+                    let dx2 = V::to_f(V::sub_i(v2.x, xq));
+                    let l = V::mul(V::sub(v1.y, yq), dx2);
+                    let r = V::mul(V::sub(v2.y, yq), dx1);
+                    let deep = V::andnot_m(V::eq_i(v2.at, within), m);
+                    let pop = V::and_m(deep, V::le(l, r));
+                    if !first && !V::any(pop) {
                         break;
                     }
                     first = false;
                     // The second vertex moves up; the one below it comes from its record
                     // (every lane reads one; those that do not pop keep v2).
-                    let v3 = load_records(below, v2.at);
+                    let v3 = V::load_records(below, v2.at);
                     (v1, v2) = (pick(v1, v2, pop), pick(v2, v3, pop));
                 }
             }};
@@ -421,12 +406,9 @@ impl HullsF32 {
         macro_rules! record {
             ($m:expr, $xq:expr, $yq:expr) => {{
                 let (m, xq, yq) = ($m, $xq, $yq);
-                store_records(below.add(self.slot * LANES * RECORD), v1);
+                V::store_records(below.add(self.slot * N * RECORD), v1);
                 let q = Top {
-                    at: _mm256_add_epi32(
-                        _mm256_set1_epi32((self.slot * LANES * RECORD * 4) as i32),
-                        within,
-                    ),
+                    at: V::add_i(si((self.slot * N * RECORD * 4) as i32), within),
                     y: yq,
                     x: xq,
                 };
@@ -436,102 +418,82 @@ impl HullsF32 {
         }
         // 2. Far: the tangent from (τ_P, f_P).
         pop_while!(on, xp, fp, true);
-        let dx_far = _mm256_cvtepi32_ps(_mm256_sub_epi32(v1.x, xp));
-        let far = _mm256_add_ps(
-            _mm256_mul_ps(
-                _mm256_div_ps(_mm256_sub_ps(v1.y, fp), dx_far),
-                _mm256_set1_ps(s.scale),
-            ),
-            _mm256_set1_ps(s.shift),
+        let dx_far = V::to_f(V::sub_i(v1.x, xp));
+        let far = V::add(
+            V::mul(V::div(V::sub(v1.y, fp), dx_far), sf(s.scale)),
+            sf(s.shift),
         );
-        let empty = _mm256_cmpeq_epi32(v1.at, within);
-        let far = _mm256_blendv_ps(
-            far,
-            _mm256_set1_ps(f32::NEG_INFINITY),
-            _mm256_castsi256_ps(empty),
-        );
+        let empty = V::eq_i(v1.at, within);
+        let far = V::blend_f(far, sf(f32::NEG_INFINITY), empty);
         // 3. Where the period's largest slope beats the far one, its samples from m on that lie
         // above the chord from P to the far tangent point and their neighbours' segments.
-        let active = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(best, far));
-        let y_at = |i: usize| {
-            _mm256_add_ps(
-                ld_f(heights.get_unchecked(i)),
-                _mm256_sub_ps(zp, _mm256_set1_ps(*s.drop.get_unchecked(i))),
-            )
-        };
+        let active = V::gt(best, far);
+        macro_rules! y_at {
+            ($i:expr) => {
+                V::add(
+                    ld_f!(heights.get_unchecked($i)),
+                    V::sub(zp, sf(*s.drop.get_unchecked($i))),
+                )
+            };
+        }
         let dx_at = |i: usize| *s.offsets_f.get_unchecked(i);
         // Where every lane has all k samples (away from the map's edge), none needs its count.
-        let full = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
-            count,
-            _mm256_set1_epi32(k as i32),
-        ))) == 0xff;
+        let full = V::all(V::eq_i(count, si(k as i32)));
         // The right end: the last sample kept (P′ first), the far tangent point before any.
         let (mut xr, mut yr) = (dx_far, v1.y);
-        let mut has_r = _mm256_xor_si256(empty, _mm256_set1_epi32(-1));
+        let mut has_r = V::not_m(empty);
         // No lane pushes a sample before its period's tangent point (`from` below): the loop
         // stops at the first of those over the active lanes (none where none is active).
-        let act_on = _mm256_and_si256(active, on);
-        let lo = min_lane(_mm256_blendv_epi8(
-            _mm256_set1_epi32(k as i32 + 1),
-            argmax,
-            act_on,
-        )) as usize;
+        let act_on = V::and_m(active, on);
+        let lo = V::min_lane(V::blend_i(si(k as i32 + 1), argmax, act_on)) as usize;
         let mut y = f_next;
         for i in (lo..=k).rev() {
             let (xi, dxv) = if i == k {
                 (s.xp + s.next, dx_next)
             } else {
-                (s.xp + *s.offsets.get_unchecked(i), _mm256_set1_ps(dx_at(i)))
+                (s.xp + *s.offsets.get_unchecked(i), sf(dx_at(i)))
             };
-            let y_p = _mm256_sub_ps(y, fp);
-            let under = _mm256_cmp_ps::<_CMP_LE_OQ>(
-                _mm256_mul_ps(y_p, xr),
-                _mm256_mul_ps(_mm256_sub_ps(yr, fp), dxv),
-            );
+            let under = V::le(V::mul(V::sub(y, fp), xr), V::mul(V::sub(yr, fp), dxv));
             // The left neighbour: the next sample nearer P, or P itself.
             let (xl, yl) = if i == 0 {
-                (_mm256_setzero_ps(), fp)
+                (sf(0.0), fp)
             } else {
-                (_mm256_set1_ps(dx_at(i - 1)), y_at(i - 1))
+                (sf(dx_at(i - 1)), y_at!(i - 1))
             };
-            let dent = _mm256_cmp_ps::<_CMP_LE_OQ>(
-                _mm256_mul_ps(_mm256_sub_ps(y, yl), _mm256_sub_ps(xr, xl)),
-                _mm256_mul_ps(_mm256_sub_ps(yr, yl), _mm256_sub_ps(dxv, xl)),
+            let dent = V::le(
+                V::mul(V::sub(y, yl), V::sub(xr, xl)),
+                V::mul(V::sub(yr, yl), V::sub(dxv, xl)),
             );
-            let skip = _mm256_and_si256(has_r, _mm256_castps_si256(_mm256_or_ps(under, dent)));
+            let skip = V::and_m(has_r, V::or_m(under, dent));
             let kept = if i == k {
-                _mm256_andnot_si256(skip, prev_on)
+                V::andnot_m(skip, prev_on)
             } else if full {
-                _mm256_xor_si256(skip, _mm256_set1_epi32(-1))
+                V::not_m(skip)
             } else {
-                _mm256_andnot_si256(skip, _mm256_cmpgt_epi32(count, _mm256_set1_epi32(i as i32)))
+                V::andnot_m(skip, V::gt_i(count, si(i as i32)))
             };
-            let keptf = _mm256_castsi256_ps(kept);
             (xr, yr, has_r) = (
-                _mm256_blendv_ps(xr, dxv, keptf),
-                _mm256_blendv_ps(yr, y, keptf),
-                _mm256_or_si256(has_r, kept),
+                V::blend_f(xr, dxv, kept),
+                V::blend_f(yr, y, kept),
+                V::or_m(has_r, kept),
             );
-            let from = _mm256_cmpgt_epi32(_mm256_set1_epi32(i as i32 + 1), argmax);
+            let from = V::gt_i(si(i as i32 + 1), argmax);
             // Every sample from `lo` on is pushed in the lanes of m, none where m is empty (no
             // pops, and a slot recorded but never read): a branch on m, taken about two times
             // in three, cost more in mispredictions than the push it saved (4 % of a build).
-            let m = _mm256_and_si256(kept, _mm256_and_si256(act_on, from));
-            push!(m, _mm256_set1_epi32(xi), y);
+            let m = V::and_m(kept, V::and_m(act_on, from));
+            push!(m, si(xi), y);
             y = yl;
         }
-        let st_i = |a: &mut [i32; LANES], v: __m256i| {
-            _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, v)
-        };
         for (k, v) in [v1, v2].into_iter().enumerate() {
-            st_i(&mut self.top[k], v.at);
-            st_i(&mut self.top_x[k], v.x);
-            _mm256_storeu_ps(self.top_y[k].as_mut_ptr(), v.y);
+            V::store_i(self.top[k].as_mut_ptr(), v.at);
+            V::store_i(self.top_x[k].as_mut_ptr(), v.x);
+            V::store_f(self.top_y[k].as_mut_ptr(), v.y);
         }
-        _mm256_storeu_ps(self.f_prev.as_mut_ptr(), fp);
-        st_i(&mut self.prev_on, on);
-        let mut out = [0.0; LANES];
-        _mm256_storeu_ps(out.as_mut_ptr(), _mm256_max_ps(near, far));
+        V::store_f(self.f_prev.as_mut_ptr(), fp);
+        V::store_i(self.prev_on.as_mut_ptr(), V::ints_of(on));
+        let mut out = [0.0; N];
+        V::store_f(out.as_mut_ptr(), V::max(near, far));
         out
     }
 }

@@ -12,7 +12,8 @@
 //! the exact step of the f32 slope, and `tests/terrain_horizon.rs` the map's from the exact
 //! horizon. It saves the two f64 divisions and conversions of `encode` per eight lanes.
 
-use super::horizon_hull::LANES;
+#[cfg(target_arch = "x86_64")]
+use super::horizon_lanes::Lanes;
 
 /// 65535/π: u16 steps per radian (the map's step is 180°/65535).
 const STEPS_PER_RAD: f32 = (65535.0 / std::f64::consts::PI) as f32;
@@ -25,71 +26,59 @@ fn step_of(atan: f32) -> u16 {
 }
 
 /// Slopes (t units) to the horizon map's u16: atan of slope/metres_per_t ([`atan_f32`]), then
-/// its step ([`step_of`]). The portable twin of [`quantise_avx2`].
+/// its step ([`step_of`]). The portable twin of [`quantise_simd`].
 #[inline(always)]
-fn quantise(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
-    let mut out = [0u16; LANES];
+pub(super) fn quantise<const N: usize>(slopes: &[f32; N], inv_m: f32) -> [u16; N] {
+    let mut out = [0u16; N];
     for (o, &s) in out.iter_mut().zip(slopes) {
         *o = step_of(atan_f32(s * inv_m));
     }
     out
 }
 
-/// [`quantise`] of eight lanes, in AVX2 where `avx2` (detected): the same operations, the
-/// same bits (a proptest).
-#[inline(always)]
-pub(super) fn quantise_lanes(slopes: &[f32; LANES], inv_m: f32, avx2: bool) -> [u16; LANES] {
-    #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        // SAFETY: AVX2 was detected.
-        return unsafe { quantise_avx2(slopes, inv_m) };
-    }
-    let _ = avx2;
-    quantise(slopes, inv_m)
-}
-
-/// [`quantise`] on eight lanes: [`atan_f32`]'s selects as blends, then [`step_of`].
+/// [`quantise`] on N lanes of `V`: [`atan_f32`]'s selects as blends, then [`step_of`]; the
+/// same operations, the same bits (a proptest).
 ///
 /// # Safety
-/// AVX2 must be available (the caller an AVX2 or wider `#[target_feature]` entry point, into which
+/// The CPU must have `V`'s features (the caller an entry point compiled for them, into which
 /// this inlines).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn quantise_avx2(slopes: &[f32; LANES], inv_m: f32) -> [u16; LANES] {
-    use std::arch::x86_64::*;
-    let f = _mm256_set1_ps;
-    let v = _mm256_mul_ps(_mm256_loadu_ps(slopes.as_ptr()), f(inv_m));
-    let sign = _mm256_and_ps(v, f(-0.0));
-    let a = _mm256_andnot_ps(f(-0.0), v);
-    let big = _mm256_cmp_ps::<_CMP_GT_OQ>(a, f(TAN_3PI_8));
-    let mid = _mm256_cmp_ps::<_CMP_GT_OQ>(a, f(TAN_PI_8));
-    let r_big = _mm256_div_ps(f(-1.0), a);
-    let r_mid = _mm256_div_ps(_mm256_sub_ps(a, f(1.0)), _mm256_add_ps(a, f(1.0)));
-    let r = _mm256_blendv_ps(_mm256_blendv_ps(a, r_mid, mid), r_big, big);
-    let base = _mm256_blendv_ps(
-        _mm256_blendv_ps(f(0.0), f(std::f32::consts::FRAC_PI_4), mid),
+pub(super) unsafe fn quantise_simd<V: Lanes<N>, const N: usize>(
+    slopes: &[f32; N],
+    inv_m: f32,
+) -> [u16; N] {
+    let f = V::splat_f;
+    let v = V::mul(V::load_f(slopes.as_ptr()), f(inv_m));
+    let sign = V::sign(v);
+    let a = V::abs(v);
+    let big = V::gt(a, f(TAN_3PI_8));
+    let mid = V::gt(a, f(TAN_PI_8));
+    let r_big = V::div(f(-1.0), a);
+    let r_mid = V::div(V::sub(a, f(1.0)), V::add(a, f(1.0)));
+    let r = V::blend_f(V::blend_f(a, r_mid, mid), r_big, big);
+    let base = V::blend_f(
+        V::blend_f(f(0.0), f(std::f32::consts::FRAC_PI_4), mid),
         f(std::f32::consts::FRAC_PI_2),
         big,
     );
-    let z = _mm256_mul_ps(r, r);
+    let z = V::mul(r, r);
     let [c0, c1, c2, c3] = ATAN_POLY;
-    let mut p = _mm256_sub_ps(_mm256_mul_ps(f(c0), z), f(c1));
-    p = _mm256_add_ps(_mm256_mul_ps(p, z), f(c2));
-    p = _mm256_sub_ps(_mm256_mul_ps(p, z), f(c3));
-    p = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(p, z), r), r);
-    let atan = _mm256_or_ps(_mm256_andnot_ps(f(-0.0), _mm256_add_ps(base, p)), sign);
+    let mut p = V::sub(V::mul(f(c0), z), f(c1));
+    p = V::add(V::mul(p, z), f(c2));
+    p = V::sub(V::mul(p, z), f(c3));
+    p = V::add(V::mul(V::mul(p, z), r), r);
+    let atan = V::or_f(V::abs(V::add(base, p)), sign);
     // The step (`step_of`): ceil is exact; `max` returns its second operand, 0, for NaN.
-    let x = _mm256_add_ps(_mm256_mul_ps(atan, f(STEPS_PER_RAD)), f(32767.0));
-    let x = _mm256_min_ps(_mm256_max_ps(_mm256_ceil_ps(x), f(0.0)), f(65535.0));
-    let q = _mm256_cvttps_epi32(x);
-    let mut out = [0u16; LANES];
-    let q = _mm_packus_epi32(_mm256_castsi256_si128(q), _mm256_extracti128_si256::<1>(q));
-    _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, q);
+    let x = V::add(V::mul(atan, f(STEPS_PER_RAD)), f(32767.0));
+    let x = V::min(V::max(V::ceil(x), f(0.0)), f(65535.0));
+    let mut out = [0u16; N];
+    V::store_u16(out.as_mut_ptr(), V::to_i(x));
     out
 }
 
 /// Cephes' `atanf` reduction bounds, tan(3π/8) and tan(π/8), and its polynomial's magnitudes
-/// ((c₀z − c₁)z + c₂)z − c₃, shared by [`atan_f32`] and [`quantise_avx2`].
+/// ((c₀z − c₁)z + c₂)z − c₃, shared by [`atan_f32`] and [`quantise_simd`].
 #[allow(clippy::excessive_precision)] // Cephes' constants as published
 const TAN_3PI_8: f32 = 2.414_213_562_373_095;
 #[allow(clippy::excessive_precision)]
@@ -161,17 +150,38 @@ mod tests {
     }
 
     proptest! {
-        /// The AVX2 quantisation gives the portable one's u16 on every lane.
+        /// The vector quantisation, eight lanes of AVX2 and sixteen of AVX-512 where the CPU
+        /// has them, gives the portable one's u16 on every lane.
         #[test]
-        fn avx2_quantise_equals_the_portable_one(
-            slopes in prop::array::uniform8(any_slope()),
+        fn vector_quantise_equals_the_portable_one(
+            slopes in prop::array::uniform16(any_slope()),
             inv_m in prop_oneof![Just(1.0f32), Just(1.0 / 40.0), 1e-4f32..1e2],
         ) {
+            // CI machines have AVX2 (x86-64-v3): there the comparison must run.
             if !crate::cpu::has_avx2() {
                 prop_assert!(std::env::var_os("CI").is_none(), "no AVX2 on this CI machine");
                 return Ok(());
             }
-            prop_assert_eq!(quantise_lanes(&slopes, inv_m, true), quantise(&slopes, inv_m));
+            let want = quantise(&slopes, inv_m);
+            #[cfg(target_arch = "x86_64")]
+            for simd in crate::cpu::Simd::available().into_iter().skip(1) {
+                use crate::terrain::horizon_lanes::{Avx2, Avx512};
+                // SAFETY: the level was detected.
+                let got: [u16; 16] = unsafe {
+                    match simd {
+                        crate::cpu::Simd::Avx2 => {
+                            let half = |h: usize| slopes[h..h + 8].try_into().unwrap();
+                            let (lo, hi) = (
+                                quantise_simd::<Avx2, 8>(&half(0), inv_m),
+                                quantise_simd::<Avx2, 8>(&half(8), inv_m),
+                            );
+                            std::array::from_fn(|j| if j < 8 { lo[j] } else { hi[j - 8] })
+                        }
+                        _ => quantise_simd::<Avx512, 16>(&slopes, inv_m),
+                    }
+                };
+                prop_assert_eq!(got, want, "{:?}", simd);
+            }
         }
     }
 

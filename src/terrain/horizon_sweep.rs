@@ -276,7 +276,7 @@ fn sweep_bundles_with(
         kappa,
         avx2,
     };
-    let bundles = bundle_list(map, dir);
+    let bundles = bundle_list(map, dir, LANES);
     assert_eq!(out.len(), (w * h) as usize);
     let k = per.len() - 1;
     bundles.par_chunks(8).for_each_init(

@@ -100,7 +100,7 @@ impl Bands {
     pub fn end_step(&mut self, step: usize, y: usize) {
         let slots = self.prev_row.len();
         self.prev_row[step % slots] = y as u32;
-        if (step + 1) % BLOCK == 0 || step + 1 == self.steps {
+        if (step + 1).is_multiple_of(BLOCK) || step + 1 == self.steps {
             let (b, sups) = (step / BLOCK, self.sups());
             for (i, c) in self.cur.iter_mut().enumerate() {
                 self.hist[i * self.blocks + b] = *c;
