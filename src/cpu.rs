@@ -1,7 +1,7 @@
 //! What the CPU can run, detected once at run time: the kernels that have an AVX2 version
 //! (the BVH traversal, the horizon sweep's bundles, the certified shadow sweep) call these and
 //! fall back to their portable code, which gives the same results, everywhere else. The f32
-//! horizon bundles also have their AVX2 code compiled for x86-64-v4 ([`Simd::Avx512`]). And
+//! horizon bundles also run sixteen lanes in AVX-512 ([`Simd::Avx512`]). And
 //! memory in huge pages for the large arrays that kernels read in strides ([`huge_vec`]).
 
 /// AVX2 (x86-64-v3 machines; every CI machine of this project).
@@ -35,9 +35,9 @@ pub enum Simd {
     Portable,
     /// AVX2 (x86-64-v3): sixteen 256-bit registers.
     Avx2,
-    /// The AVX2 code compiled for x86-64-v4 (AVX-512 F, BW, CD, DQ, VL): the same 256-bit
-    /// operations, in EVEX encodings with thirty-two registers, so a kernel that holds more
-    /// than sixteen vectors spills less. Same results as [`Simd::Avx2`].
+    /// x86-64-v4 (AVX-512 F, BW, CD, DQ, VL): thirty-two 512-bit registers and eight mask
+    /// registers. The f32 horizon bundles run sixteen lanes here; the same results as
+    /// [`Simd::Avx2`].
     Avx512,
 }
 

@@ -1,7 +1,7 @@
 //! The horizon line sweep in f32 (docs/algorithms.md §4.4): the bundles of
 //! [`super::horizon_sweep`] — the same lines, periods, stencils and walk order — with f32
-//! samples, hulls over fixed-point coordinates, eight lanes per AVX2 instruction
-//! ([`super::horizon_hull_f32`]), and the angles quantised to the horizon map's u16 on the way
+//! samples, hulls over fixed-point coordinates, bundles of eight lines in AVX2 or sixteen in
+//! AVX-512 ([`super::horizon_hull_f32`], [`super::horizon_lanes`]), and the angles quantised to the horizon map's u16 on the way
 //! out ([`super::horizon_quantise`]). The f64 sweep is the exact reference (bit for bit the
 //! per-pixel walk up to rounding); this one is what [`super::horizon_map::HorizonMap::build`]
 //! runs. Its error against the exact horizon is measured in `tests/terrain_horizon.rs` and

@@ -1,6 +1,7 @@
-//! The upper hulls of the f32 horizon sweep ([`super::horizon_f32`]): eight lanes (adjacent
-//! lines) per AVX2 instruction, and a portable twin that runs the same f32 operations lane by
-//! lane (a proptest holds the two bit for bit equal).
+//! The upper hulls of the f32 horizon sweep ([`super::horizon_f32`]): N lanes (adjacent
+//! lines) per instruction in the vector operations of [`super::horizon_lanes`] (eight of AVX2,
+//! sixteen of AVX-512), and a portable twin that runs the same f32 operations lane by lane (a
+//! proptest holds them bit for bit equal).
 //!
 //! **One pixel step of a lane** (pixel P at τ_P on the line, f_P = z_P − κτ_P², the line's
 //! parabola as in [`super::horizon`]; P′ = P + (a, b), the pixel of the step before):
@@ -39,16 +40,19 @@
 //! as differences, so a sample one period away keeps its place to 2^−F of a texel however far
 //! down the line it is. Heights are f32 (the map's own precision).
 //!
-//! **Layout of the AVX2 hulls.** Each push takes a slot (the same for every lane; a lane that
+//! **Layout of the vector hulls.** Each push takes a slot (the same for every lane; a lane that
 //! does not push leaves it unused) that records, per lane, the vertex below the pushed one:
 //! the byte offset of its own record (so that a pop reads it with no arithmetic), its height
-//! and τ, as one 16-byte record ([`super::horizon_records`]). A lane's top two vertices live
-//! in registers; each pop round reads the third from the second one's record while it tests
-//! the top two (AVX2 has sixteen registers: a third vertex in them made the compiler spill
-//! the period loop's state, and reading it cost 2 % less than keeping it). The eight lanes'
-//! records are eight 16-byte loads and a transpose: Zen 3 spends 39 µops on each eight-lane
-//! gather, and three gathers per pop round (one per field) took 17 % of a build; the records
-//! took 5–6 % off its user time (Puget Sound 1024², 64 directions). Pushes are four
+//! and τ, as one 16-byte record ([`super::horizon_lanes::Lanes::store_records`]). A lane's top
+//! two vertices live in registers; each pop round reads the third from the second one's record
+//! while it tests the top two (AVX2 has sixteen registers: a third vertex in them made the
+//! compiler spill the period loop's state, and reading it cost 2 % less than keeping it). The
+//! N lanes' records are N 16-byte loads and a transpose: Zen 3 spends 39 µops on each
+//! eight-lane gather, and three gathers per pop round (one per field) took 17 % of a build;
+//! the records took 5–6 % off its user time (Puget Sound 1024², 64 directions). With sixteen
+//! lanes on a Xeon (family 6, model 207), three AVX-512 gathers were 1.5 % faster than the
+//! loads (side by side at 1024²), not kept: the microcode fix for Gather Data Sampling makes
+//! gathers several times slower on the Skylake to Ice Lake Xeons common in clouds. Pushes are four
 //! contiguous vector stores after a transpose: no scatter. Every period sample from the
 //! loop's start on is pushed without a branch, in the lanes that keep it (none, often): a
 //! branch on whether any lane does, taken about two times in three, mispredicted at a cost

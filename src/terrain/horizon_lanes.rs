@@ -9,7 +9,11 @@
 //!
 //! Every method is `#[inline(always)]` and carries no target feature of its own: it inlines
 //! into the `#[target_feature]` entry point of its width (`bundle_avx2`, `bundle_avx512` in
-//! [`super::horizon_f32`]), which compiles it with that entry point's features.
+//! [`super::horizon_f32`]), which compiles it with that entry point's features. Code that calls
+//! these methods must not sit in a closure: a closure is compiled without the entry point's
+//! features, the intrinsics in it stay calls, and the first build of the generic kernels ran
+//! three times slower for it (the kernels use small macros and `#[inline(always)]` functions
+//! instead).
 //!
 //! # Safety
 //! Every method is `unsafe`: the CPU must have the width's features (the caller an entry point
@@ -152,7 +156,7 @@ macro_rules! direct {
 }
 
 #[cfg(target_arch = "x86_64")]
-/// Eight lanes of AVX2 (x86-64-v3; also built for x86-64-v4 by the 8-lane entry point).
+/// Eight lanes of AVX2 (x86-64-v3).
 #[derive(Clone, Copy)]
 pub(super) struct Avx2;
 

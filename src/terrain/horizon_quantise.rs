@@ -1,6 +1,6 @@
 //! The horizon f32 sweep's quantisation ([`super::horizon_f32`]): each lane's slope to the
-//! horizon map's u16 step, through Cephes' `atanf` in f32 and the step count in f32, eight
-//! lanes per AVX2 instruction with a portable twin that gives the same u16 (a proptest).
+//! horizon map's u16 step, through Cephes' `atanf` in f32 and the step count in f32, N lanes
+//! per instruction ([`super::horizon_lanes`]) with a portable twin that gives the same u16 (a proptest).
 //!
 //! **The step in f32.** `encode` rounds x = (deg + 90)/STEP_DEG in f64. Here the angle stays
 //! in radians and x − ½ = atan·K + 32767 with K = 65535/π, rounded up (ties down, so that flat
@@ -10,7 +10,7 @@
 //! cost as much (1.4·10⁻³ of a step). So a value can differ from `encode`'s by one step only
 //! within 0.01 of a step from a midpoint; the unit test bounds every value's distance from
 //! the exact step of the f32 slope, and `tests/terrain_horizon.rs` the map's from the exact
-//! horizon. It saves the two f64 divisions and conversions of `encode` per eight lanes.
+//! horizon. It saves the two f64 divisions and conversions of `encode` per lane.
 
 #[cfg(target_arch = "x86_64")]
 use super::horizon_lanes::Lanes;
@@ -93,7 +93,7 @@ const ATAN_POLY: [f32; 4] = [
 
 /// atan(x) in f32: Cephes' `atanf` (S. L. Moshier; the argument reduced to |x| ≤ tan(π/8)
 /// by atan x = π/2 − atan(1/x) above tan(3π/8) and π/4 + atan((x − 1)/(x + 1)) between, then
-/// a polynomial of degree 4 in x²), written with selects so that eight lanes vectorise.
+/// a polynomial of degree 4 in x²), written with selects so that lanes vectorise.
 /// Within 2 ulp of f64's atan (the unit test), about 1e-5° — far below the u16 step.
 #[inline(always)]
 pub(super) fn atan_f32(v: f32) -> f32 {
