@@ -38,6 +38,8 @@ pub(super) fn sweep_steep_u16(
 ) {
     assert!(dir.b != 0 && dir.a.abs() <= dir.b.abs());
     assert_eq!(out.len(), map.width * map.height);
+    // The kernels below need their level's instructions: never above what the CPU runs.
+    assert!(simd <= Simd::widest(), "{simd:?} asked of a CPU that runs {:?}", Simd::widest());
     match simd {
         #[cfg(target_arch = "x86_64")]
         Simd::Avx512 => sweep_lanes::<16, _>(Avx512, map, dir, planet_radius, out),
@@ -47,7 +49,8 @@ pub(super) fn sweep_steep_u16(
     }
 }
 
-/// [`sweep_steep_u16`] in bundles of N lines, run by kernel `K`, which the caller detected.
+/// [`sweep_steep_u16`] in bundles of N lines, run by kernel `K`, whose level the caller
+/// checked against the CPU's.
 fn sweep_lanes<const N: usize, K: Kernel<N>>(
     kernel: K,
     map: &HeightMap,
@@ -61,7 +64,7 @@ fn sweep_lanes<const N: usize, K: Kernel<N>>(
         || Scratch::<N>::new(plan.ts.len()),
         |scratch, chunk| {
             for &(r0, x0, n0, n1) in chunk {
-                // SAFETY: the caller detected the kernel's features.
+                // SAFETY: the caller checked the kernel's level against the CPU's.
                 unsafe { kernel.walk(&plan, scratch, (r0, x0), (n0, n1), out) };
             }
         },

@@ -98,10 +98,10 @@ pub(super) struct LaneInput<const N: usize> {
 
 /// The hulls of one bundle's lanes.
 pub(super) struct HullsF32<const N: usize> {
-    // AVX2 layout: per slot and lane, the vertex below the one pushed there, as a record
+    // Vector layout: per slot and lane, the vertex below the one pushed there, as a record
     // [at, y bits, x, x] of four i32 (`RECORD`; `at` is the byte offset of the vertex's own
-    // record, `Top`); a slot's eight records in lane order
-    // 0, 4, 1, 5, 2, 6, 3, 7 (`store_records`).
+    // record, `Top`); a slot's N records at the byte offsets `within::<N>()` (eight lanes in
+    // the order 0, 4, 1, 5, 2, 6, 3, 7; `Lanes::store_records`).
     below: Vec<i32>,
     slot: usize,
     top: [[i32; N]; 2],
@@ -131,7 +131,7 @@ impl<const N: usize> HullsF32<N> {
         }
     }
 
-    /// Empty every lane, with room for `pushes` pushes of the AVX2 path.
+    /// Empty every lane, with room for `pushes` pushes of the vector path.
     pub fn reset(&mut self, pushes: usize) {
         let n = (pushes + 1) * N * RECORD;
         // A record's byte offset is an i32 lane.
