@@ -1,13 +1,12 @@
-//! The horizon line sweep in f32 (docs/algorithms.md §4.4): the bundles of
-//! [`super::horizon_sweep`] — the same lines, periods, stencils and walk order — with f32
-//! samples, hulls over fixed-point coordinates, bundles of eight lines in AVX2 or sixteen in
-//! AVX-512 ([`super::horizon_hull_f32`], [`super::horizon_lanes`]), and the angles quantised to the horizon map's u16 on the way
-//! out ([`super::horizon_quantise`]). The f64 sweep is the exact reference (bit for bit the
-//! per-pixel walk up to rounding); this one is what [`super::horizon_map::HorizonMap::build`]
-//! runs. Its error against the exact horizon is measured in `tests/terrain_horizon.rs` and
-//! docs/terrain.md: f32 rounding of the samples and of the slopes, 3e-5° on Puget Sound 4096²
-//! (the u16 step is 0.0027°), up to 2e-3° next to a synthetic 178 m cliff between half-metre
-//! texels.
+//! The horizon line sweep in f32 (docs/algorithms.md §4.4): the bundles of [`super::horizon_sweep`]
+//! — the same lines, periods, stencils and walk order — with f32 samples, hulls over fixed-point
+//! coordinates, bundles of eight lines in AVX2 or sixteen in AVX-512 ([`super::horizon_hull_f32`],
+//! [`super::horizon_lanes`]), and the angles quantised to the horizon map's u16 on the way out
+//! ([`super::horizon_quantise`]). The f64 sweep is the exact reference (bit for bit the per-pixel
+//! walk up to rounding); this one is what [`super::horizon_map::HorizonMap::build`] runs. Its error
+//! against the exact horizon is measured in `tests/terrain_horizon.rs` and docs/terrain.md: f32
+//! rounding of the samples and of the slopes, 3e-5° on Puget Sound 4096² (the u16 step is 0.0027°),
+//! up to 2e-3° next to a synthetic 178 m cliff between half-metre texels.
 //!
 //! **Precondition:** a direction (a, b) with |b| ≥ |a| (b ≠ 0), as for the f64 bundles;
 //! [`super::horizon_sweep::Sweeper`] transposes the map for the others.
@@ -38,12 +37,6 @@ pub(super) fn sweep_steep_u16(
 ) {
     assert!(dir.b != 0 && dir.a.abs() <= dir.b.abs());
     assert_eq!(out.len(), map.width * map.height);
-    // The kernels below need their level's instructions: never above what the CPU runs.
-    assert!(
-        simd <= Simd::widest(),
-        "{simd:?} asked of a CPU that runs {:?}",
-        Simd::widest()
-    );
     match simd {
         #[cfg(target_arch = "x86_64")]
         Simd::Avx512 => sweep_lanes::<16, _>(Avx512, map, dir, planet_radius, out),
@@ -53,8 +46,7 @@ pub(super) fn sweep_steep_u16(
     }
 }
 
-/// [`sweep_steep_u16`] in bundles of N lines, run by kernel `K`, whose level the caller
-/// checked against the CPU's.
+/// [`sweep_steep_u16`] in bundles of N lines, run by kernel `K` (a level the CPU runs).
 fn sweep_lanes<const N: usize, K: Kernel<N>>(
     kernel: K,
     map: &HeightMap,
@@ -62,13 +54,20 @@ fn sweep_lanes<const N: usize, K: Kernel<N>>(
     planet_radius: Option<f64>,
     out: &[AtomicU16],
 ) {
+    // The kernel needs its level's instructions: never above what the CPU runs.
+    let cpu = Simd::widest();
+    assert!(
+        K::LEVEL <= cpu,
+        "{:?} asked of a CPU that runs {cpu:?}",
+        K::LEVEL
+    );
     let plan = Plan::new(map, dir, planet_radius, N);
     let bundles = bundle_list(map, dir, N);
     bundles.par_chunks(8).for_each_init(
         || Scratch::<N>::new(plan.ts.len()),
         |scratch, chunk| {
             for &(r0, x0, n0, n1) in chunk {
-                // SAFETY: the caller checked the kernel's level against the CPU's.
+                // SAFETY: the kernel's level was checked against the CPU's above.
                 unsafe { kernel.walk(&plan, scratch, (r0, x0), (n0, n1), out) };
             }
         },
@@ -82,6 +81,8 @@ fn sweep_lanes<const N: usize, K: Kernel<N>>(
 /// # Safety
 /// Every method requires the kernel's CPU features (none for [`Portable`]).
 trait Kernel<const N: usize>: Copy + Send + Sync {
+    /// The instructions the kernel needs.
+    const LEVEL: Simd;
     /// Walk one bundle ([`bundle_lanes`]), compiled for the kernel's features as a whole.
     unsafe fn walk(
         self,
@@ -117,6 +118,7 @@ trait Kernel<const N: usize>: Copy + Send + Sync {
 struct Portable;
 
 impl<const N: usize> Kernel<N> for Portable {
+    const LEVEL: Simd = Simd::Portable;
     unsafe fn walk(
         self,
         plan: &Plan,
@@ -159,8 +161,9 @@ impl<const N: usize> Kernel<N> for Portable {
 /// The vector kernels: [`Lanes`] `V` of N lanes, walked by the entry point `$walk`.
 #[cfg(target_arch = "x86_64")]
 macro_rules! vector_kernel {
-    ($v:ty, $n:literal, $walk:ident) => {
+    ($v:ty, $n:literal, $walk:ident, $level:expr) => {
         impl Kernel<$n> for $v {
+            const LEVEL: Simd = $level;
             unsafe fn walk(
                 self,
                 plan: &Plan,
@@ -200,9 +203,9 @@ macro_rules! vector_kernel {
     };
 }
 #[cfg(target_arch = "x86_64")]
-vector_kernel!(Avx2, 8, bundle_avx2);
+vector_kernel!(Avx2, 8, bundle_avx2, Simd::Avx2);
 #[cfg(target_arch = "x86_64")]
-vector_kernel!(Avx512, 16, bundle_avx512);
+vector_kernel!(Avx512, 16, bundle_avx512, Simd::Avx512);
 
 /// One worker's scratch.
 struct Scratch<const N: usize> {
@@ -350,11 +353,11 @@ unsafe fn bundle_lanes<const N: usize, K: Kernel<N>>(
         let q = kernel.quantise(&slopes, inv_m);
         let first = base as usize;
         if all_fit {
-            // Every lane's pixel is on the map: one store of the eight texels, which no
-            // other lane or worker writes (the pixels of a bundle are its own).
+            // Every lane's pixel is on the map: one store of the N texels, which no other
+            // bundle or worker writes (the pixels of a bundle are its own).
             let to = &out[first..first + N];
-            // SAFETY: eight consecutive texels of `out`, written by this lane alone and read
-            // by no one until the sweep returns (an AtomicU16 has u16's layout).
+            // SAFETY: N consecutive texels of `out`, written by this bundle alone and read by
+            // no one until the sweep returns (an AtomicU16 has u16's layout).
             unsafe { std::ptr::copy_nonoverlapping(q.as_ptr(), to[0].as_ptr(), N) };
         } else {
             for j in 0..N {

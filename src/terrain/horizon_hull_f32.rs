@@ -100,8 +100,9 @@ pub(super) struct LaneInput<const N: usize> {
 pub(super) struct HullsF32<const N: usize> {
     // Vector layout: per slot and lane, the vertex below the one pushed there, as a record
     // [at, y bits, x, x] of four i32 (`RECORD`; `at` is the byte offset of the vertex's own
-    // record, `Top`); a slot's N records at the byte offsets `within::<N>()` (eight lanes in
-    // the order 0, 4, 1, 5, 2, 6, 3, 7; `Lanes::store_records`).
+    // record, `Top`); a slot's N records at the byte offsets `within::<N>()`, in memory in the
+    // lane order 0, 4, 1, 5, 2, 6, 3, 7 for eight lanes and 0, 4, 8, 12, 1, 5, 9, 13, ... for
+    // sixteen (`Lanes::store_records`).
     below: Vec<i32>,
     slot: usize,
     top: [[i32; N]; 2],

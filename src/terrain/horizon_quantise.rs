@@ -1,6 +1,7 @@
 //! The horizon f32 sweep's quantisation ([`super::horizon_f32`]): each lane's slope to the
 //! horizon map's u16 step, through Cephes' `atanf` in f32 and the step count in f32, N lanes
-//! per instruction ([`super::horizon_lanes`]) with a portable twin that gives the same u16 (a proptest).
+//! per instruction ([`super::horizon_lanes`]) with a portable twin that gives the same u16 (a
+//! proptest).
 //!
 //! **The step in f32.** `encode` rounds x = (deg + 90)/STEP_DEG in f64. Here the angle stays
 //! in radians and x − ½ = atan·K + 32767 with K = 65535/π, rounded up (ties down, so that flat
