@@ -113,7 +113,10 @@ pub(super) trait Lanes<const N: usize>: Copy {
     unsafe fn store_u16(p: *mut u16, v: Self::I);
 
     /// Each lane's record within a slot, in bytes ([`Lanes::store_records`]' layout).
-    unsafe fn within() -> Self::I;
+    #[inline(always)]
+    unsafe fn within() -> Self::I {
+        Self::load_i(const { within::<N>() }.as_ptr())
+    }
     /// Record the N lanes' vertices `v` at `to` (one slot of N records of [`RECORD`] i32:
     /// at, y's bits, x, x), as four vector stores after a transpose.
     unsafe fn store_records(to: *mut i32, v: Top<Self, N>);
@@ -135,11 +138,6 @@ pub(super) unsafe fn pick<V: Lanes<N>, const N: usize>(
         x: V::blend_i(a.x, b.x, m),
     }
 }
-
-#[cfg(target_arch = "x86_64")]
-const WITHIN_8: [i32; 8] = within::<8>();
-#[cfg(target_arch = "x86_64")]
-const WITHIN_16: [i32; 16] = within::<16>();
 
 #[cfg(target_arch = "x86_64")]
 /// Trait methods that are one intrinsic each, called with their own arguments:
@@ -266,10 +264,6 @@ impl Lanes<8> for Avx2 {
     unsafe fn store_u16(p: *mut u16, v: __m256i) {
         let q = _mm_packus_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
         _mm_storeu_si128(p as *mut __m128i, q)
-    }
-    #[inline(always)]
-    unsafe fn within() -> __m256i {
-        Self::load_i(WITHIN_8.as_ptr())
     }
     /// Lanes j and j + 4 share 32 bytes: lane j's record starts at byte 32·(j mod 4) +
     /// 16·(j div 4).
@@ -417,10 +411,6 @@ impl Lanes<16> for Avx512 {
     #[inline(always)]
     unsafe fn store_u16(p: *mut u16, v: __m512i) {
         _mm256_storeu_si256(p as *mut __m256i, _mm512_cvtepi32_epi16(v))
-    }
-    #[inline(always)]
-    unsafe fn within() -> __m512i {
-        Self::load_i(WITHIN_16.as_ptr())
     }
     /// The unpacks work within 128-bit quarters: store q holds the records of lanes
     /// q, q + 4, q + 8, q + 12, so lane j's record starts at byte 64·(j mod 4) + 16·(j div 4).
