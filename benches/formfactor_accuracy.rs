@@ -7,7 +7,7 @@
 use relume::progress::Silent;
 use relume::radiosity::fixtures;
 use relume::radiosity::formfactor::{analytic, form_factors, Estimator, FormFactorParams};
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 use std::time::Instant;
 

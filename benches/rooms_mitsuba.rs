@@ -24,9 +24,9 @@
 mod room_light;
 mod util;
 
-use relume::radiosity::adaptive::AdaptiveParams;
 use relume::radiosity::formfactor::{Estimator, FormFactorParams};
-use relume::radiosity::voxelize::Resolution;
+use relume::radiosity::patches::adaptive::AdaptiveParams;
+use relume::radiosity::patches::voxelize::Resolution;
 use std::time::Instant;
 
 fn main() {

@@ -8,9 +8,9 @@
 //! RELUME_BENCH_DIRECTIONS, default "16,32,64"; RELUME_BENCH_CHECK=0 checks one pixel only).
 
 use rayon::prelude::*;
+use relume::terrain::hard::relief::{shadow_mask, HardMethod};
 use relume::terrain::horizon::horizon_exact;
-use relume::terrain::horizon_map::{decode, HorizonMap, HorizonSettings};
-use relume::terrain::relief::{shadow_mask, HardMethod};
+use relume::terrain::horizon::map::{decode, HorizonMap, HorizonSettings};
 use relume::terrain::Sun;
 use std::time::Instant;
 use util::{env_list, load};
@@ -122,9 +122,9 @@ fn main() {
     // Sunlight over a day from the same map (issue 14 item 4: "a day at 10-minute steps costs
     // little more than one horizon pass"): Seattle's summer solstice, hours only and with the
     // clear-sky insolation.
-    let date = relume::terrain::solar::Instant::parse("2026-06-21T00:00:00Z").unwrap();
-    let place = relume::terrain::solar::Place::new(47.6, -122.3, 0.0).unwrap();
-    let steps = relume::terrain::sunlight::day_steps(&date, &place, 600.0, 0.0).unwrap();
+    let date = relume::terrain::sun::solar::Instant::parse("2026-06-21T00:00:00Z").unwrap();
+    let place = relume::terrain::sun::solar::Place::new(47.6, -122.3, 0.0).unwrap();
+    let steps = relume::terrain::horizon::sunlight::day_steps(&date, &place, 600.0, 0.0).unwrap();
     println!(
         "\n### Sunlight over a day from the map ({} steps of 10 minutes)\n",
         steps.len()
@@ -133,7 +133,8 @@ fn main() {
     println!("|---|---|");
     for insolation in [false, true] {
         let t = Instant::now();
-        let (hours, _) = relume::terrain::sunlight::sunlight(&map, &hm, &steps, insolation);
+        let (hours, _) =
+            relume::terrain::horizon::sunlight::sunlight(&map, &hm, &steps, insolation);
         let secs = t.elapsed().as_secs_f64();
         assert_eq!(hours.len(), map.width * map.height);
         println!(

@@ -17,7 +17,7 @@
 
 use rayon::prelude::*;
 use relume::heightmap::HeightMap;
-use relume::terrain::exact_traversal::sample_bilinear;
+use relume::terrain::hard::exact_traversal::sample_bilinear;
 use relume::terrain::horizon::{directions, horizon_exact, Direction};
 use util::{env, env_list, load};
 

@@ -9,8 +9,8 @@
 
 use rayon::prelude::*;
 use relume::heightmap::HeightMap;
-use relume::terrain::accelerated_traversal::shadowed_accelerated;
-use relume::terrain::exact_traversal::shadowed_exact;
+use relume::terrain::hard::accelerated_traversal::shadowed_accelerated;
+use relume::terrain::hard::exact_traversal::shadowed_exact;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 use std::time::Instant;
 use util::{cpu_seconds, env, load};

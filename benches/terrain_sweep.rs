@@ -10,8 +10,8 @@
 //! RELUME_BENCH_A2=0 skips the traversal and the comparisons, for profiling the sweep alone).
 
 use rayon::prelude::*;
-use relume::terrain::relief::{shadow_mask, HardMethod};
-use relume::terrain::sweep::shadow_mask_sweep;
+use relume::terrain::hard::relief::{shadow_mask, HardMethod};
+use relume::terrain::hard::sweep::shadow_mask_sweep;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 use std::time::Instant;
 use util::{env, env_list, load};

@@ -6,10 +6,10 @@
 
 use relume::progress::Silent;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::transport::{
     products, transport, Bounces, InfiniteSolver, Power, TransportParams,
 };
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use std::time::Instant;
 
 fn main() {

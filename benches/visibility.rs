@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use relume::progress::Silent;
 use relume::radiosity::formfactor::{form_factors, Context, Estimator, FormFactorParams};
 use relume::radiosity::geometry::{cosine_direction, item_rng};
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use std::time::Instant;
 
 fn main() {

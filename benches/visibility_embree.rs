@@ -28,7 +28,7 @@ use embree_rays::{
     f32_rays, f32_segments, hemisphere_rays, pairwise_segments, write_for_embree, write_segments,
 };
 use rayon::prelude::*;
-use relume::radiosity::visibility::Ray;
+use relume::raytrace::visibility::Ray;
 use std::path::Path;
 use std::time::Instant;
 

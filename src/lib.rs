@@ -20,6 +20,7 @@ pub mod pipeline;
 pub mod player;
 pub mod progress;
 pub mod radiosity;
+pub mod raytrace;
 pub mod render;
 pub mod scene;
 pub mod study;

@@ -10,7 +10,7 @@ use relume::compress::{
     compress, gather, reorder, split_top, DenseEncoding, EncodeOptions, ReorderMetric,
     ReorderOptions, Sidecar,
 };
-use relume::radiosity::matrix::is_permutation;
+use relume::radiosity::transport::matrix::is_permutation;
 use relume::radiosity::TransportMatrix;
 
 fn opts(encoding: DenseEncoding) -> EncodeOptions {

@@ -108,7 +108,7 @@ fn cornell_box_radiosity_kernels_and_frame_match_the_cpu() {
     let Player::Mesh(m) = &player else {
         panic!("a mesh bake")
     };
-    // The player draws the display mesh (radiosity::display): its corners' lists.
+    // The player draws the display mesh (radiosity::mesh::display): its corners' lists.
     let (display_set, rt) = m.radiosity.as_ref().expect("the bake has a transport");
     let corners = corner_indirect(display_set, &b);
     let e_gpu = flat(&readback::read_f32(&gpu, &rt.exitance).unwrap());

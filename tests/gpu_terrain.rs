@@ -1,6 +1,6 @@
 //! Terrain on the GPU (lavapipe in CI) against the CPU: the hard-shadow kernels of
-//! `shaders/terrain_shadow.wgsl` against the f32 twins (`terrain::hard_f32`, same arithmetic)
-//! and the f64 reference (`terrain::relief::shadow_mask`), and the terrain shading against
+//! `shaders/terrain_shadow.wgsl` against the f32 twins (`terrain::hard::hard_f32`, same arithmetic)
+//! and the f64 reference (`terrain::hard::relief::shadow_mask`), and the terrain shading against
 //! `render::terrain_shading` in the top-down map view.
 
 mod common;
@@ -11,8 +11,8 @@ use relume::gpu::terrain_renderer::TerrainRenderer;
 use relume::gpu::{timing::PassTimer, Gpu};
 use relume::heightmap::{load_heightmap, HeightMap, HeightMapOptions};
 use relume::render::terrain_shading::{map_view, TerrainSettings};
-use relume::terrain::hard_f32::{shadowed_accelerated_f32, shadowed_exact_f32, TrackF32};
-use relume::terrain::relief::{shadow_mask, HardMethod};
+use relume::terrain::hard::hard_f32::{shadowed_accelerated_f32, shadowed_exact_f32, TrackF32};
+use relume::terrain::hard::relief::{shadow_mask, HardMethod};
 use relume::terrain::sun::{Sun, Track};
 use relume::terrain::MinMaxMipmap;
 use relume::theme::ThemeSet;
@@ -317,7 +317,7 @@ fn player_renders_a_height_map_bake_headless() {
 /// azimuth, against the exact traversal. Returns nothing; asserts.
 #[test]
 fn gpu_horizon_masks_match_the_twin_and_the_exact_mask() {
-    use relume::terrain::horizon_map::{decode, HorizonMap, HorizonSettings};
+    use relume::terrain::horizon::map::{decode, HorizonMap, HorizonSettings};
     let Some(gpu) = gpu() else { return };
     let map = srtm_half();
     let mip = MinMaxMipmap::build(&map);
@@ -393,7 +393,7 @@ fn gpu_horizon_masks_match_the_twin_and_the_exact_mask() {
         if g[i] != exact[i] {
             let h = decode(hm.angles[k][i]);
             assert!(
-                (h - 12.0).abs() <= relume::terrain::horizon_map::STEP_DEG,
+                (h - 12.0).abs() <= relume::terrain::horizon::map::STEP_DEG,
                 "texel {i}: horizon {h}° vs sun 12°"
             );
         }
@@ -402,7 +402,7 @@ fn gpu_horizon_masks_match_the_twin_and_the_exact_mask() {
 
 #[test]
 fn map_view_with_horizon_shadows_matches_the_cpu_shading() {
-    use relume::terrain::horizon_map::{HorizonMap, HorizonSettings};
+    use relume::terrain::horizon::map::{HorizonMap, HorizonSettings};
     let Some(gpu) = gpu() else { return };
     let map = srtm_half();
     let mip = MinMaxMipmap::build(&map);

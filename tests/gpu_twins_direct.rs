@@ -46,7 +46,7 @@ fn light_end(l: &GpuLight, p: Vec3) -> Vec3 {
 #[test]
 fn direct_light_kernel_with_punctual_lights_and_shadow_maps_matches_its_twin() {
     use relume::radiosity::fixtures::SceneBuilder;
-    use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+    use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
     use relume::render::direct::patch_exitance;
     let Some(gpu) = gpu() else { return };
     // A floor and a floating square above it.

@@ -206,10 +206,10 @@ fn pillow_reads_our_pngs_with_the_values_we_wrote() {
     .unwrap()
     .0;
     let sun = relume::terrain::Sun::new(300.0, 10.0).unwrap();
-    let mask_values: Vec<u8> = relume::terrain::relief::shadow_mask(
+    let mask_values: Vec<u8> = relume::terrain::hard::relief::shadow_mask(
         &map,
         &sun,
-        relume::terrain::relief::HardMethod::Exact,
+        relume::terrain::hard::relief::HardMethod::Exact,
         None,
         &relume::progress::Silent,
     )

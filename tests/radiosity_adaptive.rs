@@ -7,9 +7,9 @@ mod common;
 mod room_light;
 
 use common::*;
-use relume::radiosity::adaptive::AdaptiveParams;
 use relume::radiosity::fixtures::random_soup;
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::patches::adaptive::AdaptiveParams;
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::PatchSet;
 use relume::scene::Scene;
 use serde_json::Value;

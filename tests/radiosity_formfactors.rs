@@ -9,7 +9,7 @@ use relume::radiosity::fixtures::{self, SceneBuilder};
 use relume::radiosity::formfactor::{
     analytic, form_factors, Estimator, FormFactorParams, FormFactors,
 };
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::PatchSet;
 use relume::scene::Scene;
 

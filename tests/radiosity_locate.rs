@@ -3,9 +3,9 @@
 use glam::DVec3;
 use proptest::prelude::*;
 use relume::radiosity::fixtures;
+use relume::radiosity::formfactor::locate::PatchLocator;
 use relume::radiosity::geometry;
-use relume::radiosity::locate::PatchLocator;
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::PatchSet;
 use relume::scene::Scene;
 
@@ -85,7 +85,7 @@ proptest! {
             let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
             let p = a + (b - a) * u + (c - a) * v;
             let axis = loc.triangle_axis(t);
-            let voxel = relume::radiosity::locate::voxel_of(p, set.dims);
+            let voxel = relume::radiosity::formfactor::locate::voxel_of(p, set.dims);
             shared += (loc.candidates(voxel, axis).len() > 1) as usize;
             prop_assert_eq!(loc.locate_hit(p, t), loc.locate(p, axis));
         }

@@ -5,11 +5,11 @@ use proptest::prelude::*;
 use relume::progress::Silent;
 use relume::radiosity::fixtures;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
-use relume::radiosity::reference::gauss_seidel;
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::transport::reference::gauss_seidel;
 use relume::radiosity::transport::{
     transport, Bounces, InfiniteSolver, Power, Transport, TransportParams, F32_ACCEPT,
 };
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 
 const BIG: u64 = 1 << 40;

@@ -8,7 +8,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 use relume::radiosity::fixtures::random_soup;
 use relume::radiosity::geometry::Frame;
-use relume::radiosity::visibility::{Ray, Visibility};
+use relume::raytrace::visibility::{Ray, Visibility};
 use relume::scene::builder::SceneBuilder;
 use relume::scene::Scene;
 

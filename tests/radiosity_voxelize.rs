@@ -5,13 +5,13 @@
 use glam::DVec3;
 use proptest::prelude::*;
 use relume::progress::Silent;
-use relume::radiosity::corners::interpolate;
 use relume::radiosity::fixtures::{self, SceneBuilder};
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
 use relume::radiosity::geometry::{self, dominant_axis};
-use relume::radiosity::overlap::{visible_parts, Face};
+use relume::radiosity::patches::corners::interpolate;
+use relume::radiosity::patches::overlap::{visible_parts, Face};
+use relume::radiosity::patches::voxelize::{clip_to_voxels, voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::transport::{transport, Bounces, Power, TransportParams};
-use relume::radiosity::voxelize::{clip_to_voxels, voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::PatchSet;
 use relume::scene::Scene;
 
@@ -167,8 +167,8 @@ fn transfer_weights_are_convex_and_orientation_compatible() {
 /// orientation (the wall and door leaf) and occluded pairs.
 #[test]
 fn corner_lists_equal_weighting_each_corner_alone() {
-    use relume::radiosity::corners::PointTransfer;
-    use relume::radiosity::visibility::Visibility;
+    use relume::radiosity::patches::corners::PointTransfer;
+    use relume::raytrace::visibility::Visibility;
     let scene = relume::scene::load_scene(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/generated/door-ajar.obj"),
         Default::default(),

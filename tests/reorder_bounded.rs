@@ -133,7 +133,7 @@ proptest! {
 #[test]
 fn budgeted_walk_is_a_permutation_and_compresses_nearly_as_well() {
     use relume::compress::{compress, DenseEncoding, EncodeOptions};
-    use relume::radiosity::matrix::is_permutation;
+    use relume::radiosity::transport::matrix::is_permutation;
     let m = transport_box::transport(&transport_box::closed_box(8, 7), None);
     let sum_error = |method| {
         let mut copy = m.clone();

@@ -12,9 +12,9 @@ use relume::progress::Silent;
 use relume::radiosity::formfactor::{
     assemble, form_factor_rows, form_factors, shard_rows, Estimator, FormFactorParams,
 };
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::transport::shard::{assemble_infinite, factor_channels, solve_part};
 use relume::radiosity::transport::{transport, Bounces, Power, TransportParams};
-use relume::radiosity::transport_shard::{assemble_infinite, factor_channels, solve_part};
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
 

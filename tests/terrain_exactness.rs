@@ -9,10 +9,10 @@ mod terrain_common;
 
 use proptest::prelude::*;
 use relume::heightmap::HeightMap;
-use relume::terrain::accelerated_traversal::shadowed_accelerated;
-use relume::terrain::exact_traversal::{sample_bilinear, shadowed_exact, track_texels};
 use relume::terrain::generate::{generate, Shape};
-use relume::terrain::sweep::shadow_mask_sweep;
+use relume::terrain::hard::accelerated_traversal::shadowed_accelerated;
+use relume::terrain::hard::exact_traversal::{sample_bilinear, shadowed_exact, track_texels};
+use relume::terrain::hard::sweep::shadow_mask_sweep;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 use terrain_common::strategies::{azimuth, cell, elevation};
 use terrain_common::{random_map, Rng};
@@ -148,7 +148,7 @@ fn ridges_beyond_a_super_block_are_settled_line_by_line() {
     // A long valley (48 × 700) closed by a rough ridge at its north end: with the sun low in the
     // north, rays from the south end graze the ridge more than 256 lines (one super-block of
     // 16 blocks of 16) away, so the sweep settles them through its super-block maxima
-    // (terrain::sweep_bands::SUPER). Both outcomes must occur and equal A1.
+    // (terrain::hard::sweep::bands::SUPER). Both outcomes must occur and equal A1.
     let (w, h) = (48, 700);
     let mut rng = Rng(23);
     let heights: Vec<f32> = (0..w * h)
@@ -169,7 +169,7 @@ fn ridges_beyond_a_super_block_are_settled_line_by_line() {
 fn distant_ridges_are_settled_line_by_line() {
     // Low ground ringed by a rough ridge: at a low sun many rays graze the ridge far from
     // their pixel, the band bound cannot clear them and the sweep settles them line by line
-    // from its block history (terrain::sweep_bands). Both outcomes must occur and equal A1.
+    // from its block history (terrain::hard::sweep::bands). Both outcomes must occur and equal A1.
     let n = 200;
     let mut rng = Rng(11);
     let heights: Vec<f32> = (0..n * n)

@@ -8,8 +8,8 @@ mod terrain_common;
 use proptest::prelude::*;
 use rayon::prelude::*;
 use relume::heightmap::HeightMap;
-use relume::terrain::exact_traversal::shadowed_exact;
-use relume::terrain::hard_f32::{shadowed_accelerated_f32, shadowed_exact_f32, TrackF32};
+use relume::terrain::hard::exact_traversal::shadowed_exact;
+use relume::terrain::hard::hard_f32::{shadowed_accelerated_f32, shadowed_exact_f32, TrackF32};
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 use terrain_common::random_map;
 

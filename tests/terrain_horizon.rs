@@ -7,8 +7,8 @@ mod terrain_common;
 
 use proptest::prelude::*;
 use relume::heightmap::HeightMap;
+use relume::terrain::horizon::sweep::horizon_sweep;
 use relume::terrain::horizon::{directions, horizon_exact, Direction};
-use relume::terrain::horizon_sweep::horizon_sweep;
 use terrain_common::random_map;
 
 /// The largest |sweep − exact| in degrees over every pixel.
@@ -156,7 +156,7 @@ const F32_ROUNDING_DEG: f64 = 5.0e-3;
 /// mid-range).
 #[test]
 fn f32_map_is_the_exact_sweep_within_rounding() {
-    use relume::terrain::horizon_map::{decode, HorizonMap, HorizonSettings, STEP_DEG};
+    use relume::terrain::horizon::map::{decode, HorizonMap, HorizonSettings, STEP_DEG};
     let mut cases = Vec::new();
     for (seed, cell) in [(1u64, [1.0, 1.0]), (2, [30.0, 30.0]), (3, [1.0, 3.0])] {
         cases.push((random_map(61, 47, seed, cell, 20.0), None));
@@ -188,8 +188,8 @@ fn f32_map_is_the_exact_sweep_within_rounding() {
 
 #[test]
 fn sky_view_and_shadows_from_the_horizon_map() {
-    use relume::terrain::horizon_map::{HorizonMap, HorizonSettings, STEP_DEG};
-    use relume::terrain::{relief::shadow_mask, relief::HardMethod, Sun};
+    use relume::terrain::horizon::map::{HorizonMap, HorizonSettings, STEP_DEG};
+    use relume::terrain::{hard::relief::shadow_mask, hard::relief::HardMethod, Sun};
     // Flat ground sees the whole sky; a pit of depth d and radius R (here: the centre of a
     // 9-texel-wide square well) sees less.
     let flat = HeightMap::new(16, 16, vec![0.0; 256], [1.0, 1.0]);
@@ -203,7 +203,7 @@ fn sky_view_and_shadows_from_the_horizon_map() {
         let sweep = horizon_sweep(&map, d, None);
         for (q, s) in plane.iter().zip(&sweep) {
             assert!(
-                (relume::terrain::horizon_map::decode(*q) - *s as f64).abs()
+                (relume::terrain::horizon::map::decode(*q) - *s as f64).abs()
                     <= 0.5 * STEP_DEG + F32_ROUNDING_DEG
             );
         }
@@ -236,7 +236,7 @@ fn sky_view_and_shadows_from_the_horizon_map() {
 /// The parabolic model by brute force: every sample of P's walk with the drop κ·t², κ =
 /// metres_per_t²/(2R) — what the sweep must equal (its hull over f = h − κτ² is exact algebra).
 fn parabolic_exact(map: &HeightMap, dir: &Direction, col: usize, row: usize, radius: f64) -> f64 {
-    use relume::terrain::exact_traversal::{texel_sample, TrackWalk};
+    use relume::terrain::hard::exact_traversal::{texel_sample, TrackWalk};
     let track = dir.track(map.cell_size);
     let kappa = track.metres_per_t.powi(2) / (2.0 * radius);
     let zp = map.heights[row * map.width + col] as f64;

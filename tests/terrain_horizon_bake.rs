@@ -7,7 +7,7 @@ mod common;
 
 use common::{bake, data, expect_code, gpu, python, require_python};
 use relume::heightmap::HeightMap;
-use relume::terrain::horizon_map::{decode, HorizonMap, HorizonSettings};
+use relume::terrain::horizon::map::{decode, HorizonMap, HorizonSettings};
 use std::path::Path;
 use std::process::Command;
 

@@ -13,9 +13,9 @@
 
 use rayon::prelude::*;
 use relume::heightmap::HeightMap;
-use relume::terrain::accelerated_traversal::shadowed_accelerated;
-use relume::terrain::exact_traversal::shadowed_exact;
-use relume::terrain::sweep::shadow_mask_sweep;
+use relume::terrain::hard::accelerated_traversal::shadowed_accelerated;
+use relume::terrain::hard::exact_traversal::shadowed_exact;
+use relume::terrain::hard::sweep::shadow_mask_sweep;
 use relume::terrain::{MinMaxMipmap, Sun, Track};
 
 fn load(pipeline: &str) -> HeightMap {

@@ -5,7 +5,7 @@
 
 use relume::heightmap::HeightMap;
 use relume::terrain::generate::{centre, generate, Shape};
-use relume::terrain::relief::{shadow_mask, HardMethod};
+use relume::terrain::hard::relief::{shadow_mask, HardMethod};
 use relume::terrain::Sun;
 
 fn mask(map: &HeightMap, sun: &Sun) -> Vec<bool> {

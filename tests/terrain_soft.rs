@@ -9,7 +9,7 @@ mod terrain_common;
 use proptest::prelude::*;
 use relume::heightmap::HeightMap;
 use relume::progress::Silent;
-use relume::terrain::relief::{shadow_mask, HardMethod};
+use relume::terrain::hard::relief::{shadow_mask, HardMethod};
 use relume::terrain::soft::model::lit;
 use relume::terrain::soft::{soft_shadow_map, SoftContext, SoftMethod, SoftShadowParams};
 use relume::terrain::{MinMaxMipmap, Sun};

@@ -7,10 +7,10 @@ mod common;
 
 use common::{bake, expect_code};
 use relume::heightmap::HeightMap;
-use relume::terrain::horizon_map::{HorizonMap, HorizonSettings};
-use relume::terrain::relief::{shadow_mask, HardMethod};
-use relume::terrain::solar::{Instant, Place};
-use relume::terrain::sunlight::{day_steps, sunlight};
+use relume::terrain::hard::relief::{shadow_mask, HardMethod};
+use relume::terrain::horizon::map::{HorizonMap, HorizonSettings};
+use relume::terrain::horizon::sunlight::{day_steps, sunlight};
+use relume::terrain::sun::solar::{Instant, Place};
 use std::path::Path;
 
 fn s(p: &Path) -> &str {

@@ -1,4 +1,4 @@
-//! The certified sweep's near stencil (terrain::sweep_near) against the exact test: on random
+//! The certified sweep's near stencil (terrain::hard::sweep::near) against the exact test: on random
 //! maps and suns (exactly axis-aligned, 1e-12 and 1e-10 off an axis, 45°, elevations just above
 //! 0 and near 90°, anisotropic cells), for every pixel whose taps lie on the map, a stencil
 //! "shadowed" means a texel of the track's first `lines` major-axis lines passes the exact test
@@ -8,9 +8,9 @@ mod terrain_common;
 
 use proptest::prelude::*;
 use relume::heightmap::HeightMap;
-use relume::terrain::exact_traversal::{shadowed_exact, texel_sample, track_texels};
-use relume::terrain::sweep_bound::transpose;
-use relume::terrain::sweep_near::{decide, Axes, NearStencil};
+use relume::terrain::hard::exact_traversal::{shadowed_exact, texel_sample, track_texels};
+use relume::terrain::hard::sweep::near::{decide, Axes, NearStencil};
+use relume::terrain::transpose::transpose;
 use relume::terrain::{Sun, Track, TrackKind};
 use terrain_common::random_map;
 use terrain_common::strategies::{azimuth, cell, elevation};

@@ -18,7 +18,7 @@ use embree_rays::{
     write_segments, write_triangles,
 };
 use glam::Vec3;
-use relume::radiosity::visibility::{Ray, BACKOFF};
+use relume::raytrace::visibility::{Ray, BACKOFF};
 use relume::scene::Scene;
 use std::path::Path;
 
@@ -44,7 +44,7 @@ np.save(d + '/embree.npy', np.stack([prim.astype(np.float64), t], axis=1))
 fn compare(scene: &Scene, target: u32, k: usize, dir: &Path) -> (usize, usize, usize) {
     let (ctx, rays) = hemisphere_rays(scene, target, k, 7);
     // relume starts its f32 ray BACKOFF behind the origin (obvhs's near-hit cut-off,
-    // src/radiosity/visibility.rs), rounded separately from the f32 origin Embree gets: the two
+    // src/raytrace/visibility.rs), rounded separately from the f32 origin Embree gets: the two
     // starts differ by up to an f32 ulp of the coordinates, which moves a hit along the ray by
     // that over |cos θ| (θ between the ray and the triangle's normal). Embree has no near limit
     // to give it the same start without it hitting the surface the ray leaves.

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Reference sun positions for relume's `terrain::solar` tests, computed with pvlib's SPA.
+"""Reference sun positions for relume's `terrain::sun::solar` tests, computed with pvlib's SPA.
 
 Prints the Rust array literal `PVLIB_CASES` of (instant, latitude, longitude, elevation_m,
 delta_t_s, azimuth_deg, apparent_elevation_deg) tuples that is pasted into the tests of
-`src/terrain/solar.rs`. pvlib's `spa_python` (how="numpy") is an independent implementation of
+`src/terrain/sun/solar.rs`. pvlib's `spa_python` (how="numpy") is an independent implementation of
 NREL's SPA (Reda & Andreas 2004). Both sides use the atmosphere of relume's
 `SpaOptions::default()` (1010 mbar = 101000 Pa, 10 °C) and an explicit ΔT per case, so that only
 the algorithms are compared. The cases spread over latitudes −70..70, longitudes, seasons and

@@ -9,7 +9,7 @@ use crate::compress::dense::{DenseEncoding, DenseTexture};
 use crate::compress::logmap::LogMap;
 use crate::compress::{EncodedTransport, Sidecar};
 use crate::error::{Error, IoContext, Result};
-use crate::radiosity::matrix::is_permutation;
+use crate::radiosity::transport::matrix::is_permutation;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -17,7 +17,7 @@ pub enum ExportWhat {
     /// The scene with its baked lighting for a light setup, binary glTF ([`super::gltf`]).
     Gltf,
     /// Mean irradiance per scene object for a light setup, JSON
-    /// ([`crate::radiosity::objects`]).
+    /// ([`crate::radiosity::mesh::objects`]).
     Objects,
 }
 
@@ -123,9 +123,9 @@ pub fn export_objects(
     dir: &Path,
     setup: &super::gltf::LitExport,
     out: &Path,
-) -> Result<Vec<crate::radiosity::objects::ObjectLight>> {
+) -> Result<Vec<crate::radiosity::mesh::objects::ObjectLight>> {
     let lit = super::gltf::lit_patches(dir, setup)?;
-    let objects = crate::radiosity::objects::object_light(&lit.scene, &lit.set, &lit.b);
+    let objects = crate::radiosity::mesh::objects::object_light(&lit.scene, &lit.set, &lit.b);
     let doc = serde_json::json!({ "transport": lit.transport, "objects": objects });
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| Error::Internal(format!("cannot encode JSON: {e}")))?;

@@ -22,8 +22,8 @@
 //! Degenerate triangles are left out. Written atomically.
 
 use crate::error::{Error, Result};
-use crate::radiosity::corners::PointTransfer;
-use crate::radiosity::visibility::Visibility;
+use crate::radiosity::patches::corners::PointTransfer;
+use crate::raytrace::visibility::Visibility;
 use crate::render::direct::{gather_dense, patch_exitance};
 use crate::render::lights::{sun_light, GpuLight};
 use crate::render::mesh_reference::{shade_point, FrameSettings};

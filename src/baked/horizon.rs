@@ -2,7 +2,7 @@
 //! written by `horizon_maps` (docs/baked-format.md).
 //!
 //! - `horizon_maps.npy`: u16 `[N, H, W]`, plane k the horizon angle of every texel toward
-//!   direction k, quantised as `angle = −90° + v·180°/65535` ([`crate::terrain::horizon_map`]).
+//!   direction k, quantised as `angle = −90° + v·180°/65535` ([`crate::terrain::horizon::map`]).
 //! - `horizon_directions.npy`: i32 `[N, 2]`, direction k's texel step (a columns east, b rows
 //!   south); its azimuth follows from the step and the cell size. Sorted by azimuth.
 //!
@@ -11,8 +11,8 @@
 
 use super::{npy, BakeTransaction, Manifest};
 use crate::error::{Error, Result};
+use crate::terrain::horizon::map::HorizonMap;
 use crate::terrain::horizon::Direction;
-use crate::terrain::horizon_map::HorizonMap;
 use std::path::Path;
 
 /// File name of the angle planes.

@@ -3,7 +3,7 @@
 
 use super::BakeTransaction;
 use crate::error::{Error, IoContext, Result};
-use crate::radiosity::matrix::is_permutation;
+use crate::radiosity::transport::matrix::is_permutation;
 use std::path::Path;
 
 /// File name of the permutation.

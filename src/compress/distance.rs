@@ -16,8 +16,8 @@ pub fn l1_chunked(a: &[f32], b: &[f32]) -> f32 {
 }
 
 /// Sum of absolute differences with eight accumulators (vectorises; the summation order of
-/// `radiosity::matrix::sum_pairs8`).
+/// `radiosity::transport::matrix::sum_pairs8`).
 #[inline]
 pub fn l1(a: &[f32], b: &[f32]) -> f32 {
-    crate::radiosity::matrix::sum_pairs8(a, b, |x, y| (x - y).abs())
+    crate::radiosity::transport::matrix::sum_pairs8(a, b, |x, y| (x - y).abs())
 }

@@ -9,7 +9,7 @@
 
 use super::dense::BlockValues;
 use super::EncodedTransport;
-use crate::radiosity::matrix::{permute_vector, unpermute_vector};
+use crate::radiosity::transport::matrix::{permute_vector, unpermute_vector};
 use rayon::prelude::*;
 
 /// `B = S · E` per channel from `enc`; `e` and the result are `[channels][n]` in original

@@ -1,6 +1,6 @@
 //! Terrain on the GPU: the height field and its min/max mipmap in storage buffers, per-sun
 //! track uniforms, the hard-shadow mask kernel (`terrain_mask.wgsl`, tested against
-//! `terrain::relief::shadow_mask`) and the terrain frame (`terrain_render.wgsl`, tested against
+//! `terrain::hard::relief::shadow_mask`) and the terrain frame (`terrain_render.wgsl`, tested against
 //! `render::terrain_shading`).
 
 use super::render_target::RenderTarget;
@@ -12,7 +12,7 @@ use super::{compute, timing::PassTimer, Gpu};
 use crate::error::{Error, Result};
 use crate::heightmap::HeightMap;
 use crate::render::terrain_shading::TerrainSettings;
-use crate::terrain::horizon_map::HorizonMap;
+use crate::terrain::horizon::map::HorizonMap;
 use crate::terrain::sun::{Sun, Track, TrackKind};
 use crate::terrain::MinMaxMipmap;
 use glam::{Mat4, Vec3};
@@ -405,7 +405,8 @@ impl TerrainRenderer {
         use crate::atmosphere::Model;
         let dir = self.sun.direction();
         let k =
-            crate::terrain::relief::k_shadow(&self.sun, s.k_dark as f64, s.k_bright as f64) as f32;
+            crate::terrain::hard::relief::k_shadow(&self.sun, s.k_dark as f64, s.k_bright as f64)
+                as f32;
         // True altitudes (the display exaggerates heights).
         let exaggeration = s.vertical_exaggeration.max(1e-6) as f64;
         let eye_altitude = (eye.y as f64 / exaggeration).max(1.0);

@@ -11,7 +11,7 @@
 //! border* (the 4×4 texels [2bx−1, 2bx+2] × [2by−1, 2by+2], clamped to the map) — the footprint
 //! of the relief-shadow paper's 3×3 pattern of bilinear samples, with texel values instead of averages. Why
 //! this is conservative for every value the exact traversal samples in the block: a sample of
-//! texel T is taken at a point Q clamped into T's square, and `terrain::exact_traversal::sample_bilinear` clamps its
+//! texel T is taken at a point Q clamped into T's square, and `terrain::hard::exact_traversal::sample_bilinear` clamps its
 //! result to the range of the four texels of Q's bilinear cell; for Q in T's square those four
 //! texels lie within one texel of T (border-clamped), hence inside the block's bordered
 //! footprint. So every sample h satisfies min ≤ h ≤ max, exactly, in floating point (no

@@ -3,8 +3,8 @@
 //! knob's line and column), and the `parse_*` functions call it for command-line flags (clap
 //! `value_parser`s). Neither restates a range.
 
+use crate::radiosity::patches::voxelize::Resolution;
 use crate::radiosity::transport::Bounces;
-use crate::radiosity::voxelize::Resolution;
 use std::str::FromStr;
 
 /// A check: the value back when it is in range, else the message.
@@ -94,7 +94,7 @@ pub fn cell_size(v: (f64, f64)) -> Result<(f64, f64), String> {
 }
 
 /// `VoxelSize(s)` with s positive and finite, `TargetPatches(n)` with n ≥ 1, or `Adaptive(..)`
-/// with the ranges of [`crate::radiosity::adaptive::AdaptiveParams::check`].
+/// with the ranges of [`crate::radiosity::patches::adaptive::AdaptiveParams::check`].
 pub fn resolution(v: Resolution) -> Result<Resolution, String> {
     match v {
         Resolution::VoxelSize(s) if !(s.is_finite() && s > 0.0) => Err(format!(

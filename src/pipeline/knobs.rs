@@ -8,9 +8,9 @@ use crate::compress::containers::Container;
 use crate::compress::dense::{DenseEncoding, EncodeOptions};
 use crate::compress::reorder::{ReorderMethod, ReorderMetric, ReorderOptions};
 use crate::radiosity::formfactor::{Estimator, FormFactorParams};
+use crate::radiosity::patches::voxelize::{Resolution, VoxelizeParams};
 use crate::radiosity::transport::{Bounces, Power};
-use crate::radiosity::voxelize::{Resolution, VoxelizeParams};
-use crate::terrain::horizon_map::HorizonSettings;
+use crate::terrain::horizon::map::HorizonSettings;
 use serde::{Deserialize, Serialize};
 
 /// Knobs of `Voxelize(...)`.
@@ -279,7 +279,7 @@ impl Default for HorizonMapsKnobs {
 }
 
 impl HorizonMapsKnobs {
-    /// The settings of [`crate::terrain::horizon_map::HorizonMap::build`].
+    /// The settings of [`crate::terrain::horizon::map::HorizonMap::build`].
     pub fn settings(&self) -> HorizonSettings {
         HorizonSettings {
             directions: self.directions as usize,
@@ -289,7 +289,7 @@ impl HorizonMapsKnobs {
 }
 
 impl VoxelizeKnobs {
-    /// The parameters of [`crate::radiosity::voxelize::voxelize`].
+    /// The parameters of [`crate::radiosity::patches::voxelize::voxelize`].
     pub fn params(&self) -> VoxelizeParams {
         VoxelizeParams {
             resolution: self.resolution,

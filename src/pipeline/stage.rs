@@ -13,7 +13,7 @@ use std::path::Path;
 /// One stage of a pipeline with its knobs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Stage {
-    /// Simplify the scene into voxel patches (`crate::radiosity::voxelize`).
+    /// Simplify the scene into voxel patches (`crate::radiosity::patches::voxelize`).
     Voxelize(VoxelizeKnobs),
     /// Form factors between patches with BVH visibility (`crate::radiosity::formfactor`).
     FormFactors(FormFactorsKnobs),

@@ -10,7 +10,7 @@ use crate::gpu::mesh_renderer::MeshRenderer;
 use crate::gpu::radiosity_runtime::{RadiosityRuntime, TransportSource};
 use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
-use crate::radiosity::display::display_mesh_of;
+use crate::radiosity::mesh::display::display_mesh_of;
 use crate::radiosity::PatchSet;
 use crate::render::camera::Camera;
 use crate::render::lights::GpuLight;
@@ -47,7 +47,7 @@ impl MeshPlayer {
         let has_transport = manifest.file(baked::encoded::TRANSFER_FILE).is_some()
             || manifest.file(baked::transport::FILE).is_some();
         // With baked light, draw the display mesh: triangles split to 1.5 voxels so that the
-        // per-vertex indirect light can follow the patches (radiosity::display).
+        // per-vertex indirect light can follow the patches (radiosity::mesh::display).
         let (scene, set) = if has_transport {
             let mut set = baked::patches::read(dir)?;
             if set.corners.len() != 3 * scene.triangles.len() {

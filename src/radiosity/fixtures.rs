@@ -1,5 +1,5 @@
 //! Synthetic scenes with known answers, for tests and benchmarks: the analytic configurations
-//! of [`super::formfactor::analytic`], closed boxes (furnace tests) and two rooms separated by a
+//! of [`crate::radiosity::formfactor::analytic`], closed boxes (furnace tests) and two rooms separated by a
 //! thin wall (the transfer's leak test).
 
 pub use crate::scene::builder::SceneBuilder;

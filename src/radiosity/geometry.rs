@@ -6,31 +6,16 @@
 //! the scene's own corner and in units of the voxel makes every tolerance scale-free: a scene
 //! translated by 1e5 units or shrunk to 1e-6 units gives the same numbers.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use rand_core::{RngCore, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 /// A convex planar polygon (counter-clockwise about its normal).
 pub type Polygon = Vec<DVec3>;
 
-/// Maps world coordinates to grid coordinates and back.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Frame {
-    /// World position of the grid's corner (the scene's bounds minimum).
-    pub origin: DVec3,
-    /// World units per grid unit (the voxel size).
-    pub scale: f64,
-}
-
-impl Frame {
-    pub fn to_grid(&self, world: [f32; 3]) -> DVec3 {
-        (Vec3::from(world).as_dvec3() - self.origin) / self.scale
-    }
-
-    pub fn to_world(&self, grid: DVec3) -> DVec3 {
-        self.origin + grid * self.scale
-    }
-}
+/// Maps world coordinates to grid coordinates and back (the ray tracer's frame: it traces in
+/// the voxel grid).
+pub use crate::raytrace::Frame;
 
 /// Index 0..6 of the dominant axis direction of a normal: +x, −x, +y, −y, +z, −z.
 pub fn dominant_axis(n: DVec3) -> u8 {

@@ -14,32 +14,15 @@
 //! docs/baked-format.md describes
 //! them byte by byte.
 
-pub mod adaptive;
-pub mod clip;
-pub mod corners;
-pub mod display;
 pub mod fixtures;
 pub mod formfactor;
 pub mod geometry;
-pub mod infinite;
-pub mod locate;
-pub mod lu_panels;
-pub mod matrix;
-pub mod objects;
-pub mod overlap;
-pub mod reference;
+pub mod mesh;
+pub mod patches;
 pub mod transport;
-pub mod transport_shard;
-pub mod visibility;
-pub mod voxel_size;
-pub mod voxelize;
-pub mod watertight;
-pub mod wide_bvh;
-pub mod wide_collapse;
-pub mod wide_node;
 
-pub use matrix::TransportMatrix;
 use serde::{Deserialize, Serialize};
+pub use transport::matrix::TransportMatrix;
 
 /// Everything `voxelize` produces: the patches, the pieces of triangles they are made of, points
 /// for the runtime's direct light, and the maps from the full mesh to the patches.

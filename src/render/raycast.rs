@@ -8,7 +8,7 @@ use super::lights::{GpuLight, KIND_DIRECTIONAL};
 use super::mesh_reference::{corner_vertices, display, shade_point, FrameSettings};
 use super::tonemap::to_u8;
 use crate::radiosity::geometry::Frame;
-use crate::radiosity::visibility::Visibility;
+use crate::raytrace::visibility::Visibility;
 use crate::scene::{Material, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;

@@ -1,11 +1,11 @@
 //! The CPU twin of the terrain shading in `shaders/terrain_render.wgsl`: the same hypsometric
-//! tint, the same texel radiance (Lambert from `terrain::relief::lambert`, the relief-shadow paper's shadow
+//! tint, the same texel radiance (Lambert from `terrain::hard::relief::lambert`, the relief-shadow paper's shadow
 //! brightness k_shadow) and the same tone map, evaluated per texel — what the GPU shows in the
 //! top-down map view, pixel for texel.
 
 use super::tonemap::{to_u8, tonemap};
 use crate::heightmap::HeightMap;
-use crate::terrain::relief::{k_shadow, lambert};
+use crate::terrain::hard::relief::{k_shadow, lambert};
 use crate::terrain::sun::Sun;
 use crate::theme::ThemeSet;
 use serde::{Deserialize, Serialize};

@@ -7,8 +7,8 @@ use crate::heightmap::HeightMap;
 use crate::load::{load_input, LoadedInput};
 use crate::pipeline::{parse_pipeline, Pipeline, Stage};
 use crate::radiosity::formfactor::{Estimator, FormFactorParams};
+use crate::radiosity::patches::voxelize::Resolution;
 use crate::radiosity::transport::Bounces;
-use crate::radiosity::voxelize::Resolution;
 use crate::scene::{load_scene, Scene, SceneOptions};
 use std::path::{Path, PathBuf};
 

@@ -12,7 +12,7 @@
 //!   counts; infinite bounces. Reference: hemisphere at the most samples. Errors of F itself
 //!   (the radiosity thesis's summed error included) and of B per patch (area-weighted).
 //! - **bounces**: one patch set and F; `Finite(k)`, `Infinite`, `Auto(tol)`. Reference: the f64
-//!   Gauss–Seidel solution of `B = E + diag(ρ) F B` ([`crate::radiosity::reference`]).
+//!   Gauss–Seidel solution of `B = E + diag(ρ) F B` ([`crate::radiosity::transport::reference`]).
 
 use super::radiosity_objects::{objects_sweep, ObjectReference, ObjectsConfig};
 use super::scene_bake::{bake_scene, emitted_exitance, gathered, transport_of, SceneBake};
@@ -21,12 +21,12 @@ use super::{Column, ErrorStats, Format, Measure, Setting, Sweep};
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::{FormFactorsKnobs, TransportKnobs, VoxelizeKnobs};
 use crate::progress::{Progress, Silent};
+use crate::radiosity::formfactor::locate::PatchLocator;
 use crate::radiosity::formfactor::{form_factors, Estimator, FormFactorParams, FormFactors};
 use crate::radiosity::geometry::dominant_axis;
-use crate::radiosity::locate::PatchLocator;
-use crate::radiosity::reference::{gauss_seidel, indirect};
+use crate::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
+use crate::radiosity::transport::reference::{gauss_seidel, indirect};
 use crate::radiosity::transport::Bounces;
-use crate::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use crate::radiosity::PatchSet;
 use crate::scene::Scene;
 use glam::DVec3;

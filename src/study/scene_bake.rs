@@ -7,8 +7,8 @@ use crate::error::Result;
 use crate::limits::default_max_memory;
 use crate::progress::Silent;
 use crate::radiosity::formfactor::{form_factors, FormFactorParams, FormFactors};
+use crate::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use crate::radiosity::transport::{transport, Bounces, Power, Transport, TransportParams};
-use crate::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use crate::radiosity::PatchSet;
 use crate::scene::Scene;
 

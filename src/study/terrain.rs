@@ -13,7 +13,7 @@ use super::{relative, Column, ErrorStats, Format, Measure, PlotSpec, Setting, Sw
 use crate::error::{Error, Result};
 use crate::heightmap::HeightMap;
 use crate::progress::{Progress, Silent};
-use crate::terrain::relief::{shadow_mask, HardMethod};
+use crate::terrain::hard::relief::{shadow_mask, HardMethod};
 use crate::terrain::{MinMaxMipmap, Sun};
 
 /// What the terrain sweeps run.

@@ -21,30 +21,13 @@
 //! Per-pixel kernels are plain loops over flat arrays (no recursion, no allocation) so that
 //! the GPU player can port them line by line to WGSL.
 
-pub mod accelerated_traversal;
-pub mod exact_traversal;
 pub mod generate;
-pub mod hard_f32;
+pub mod hard;
 pub mod horizon;
-mod horizon_f32;
-mod horizon_hull;
-mod horizon_hull_f32;
-mod horizon_lanes;
-pub mod horizon_map;
-mod horizon_plan;
-mod horizon_quantise;
-pub mod horizon_sweep;
 pub use crate::heightmap::minmax_mipmap;
-pub mod relief;
 pub mod soft;
-pub mod solar;
 pub mod sun;
-pub mod sunlight;
-pub mod sweep;
-pub mod sweep_bands;
-pub mod sweep_bound;
-pub mod sweep_exact;
-pub mod sweep_near;
+pub mod transpose;
 
 pub use minmax_mipmap::MinMaxMipmap;
 pub use sun::{Sun, Track, TrackKind};

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use relume::radiosity::formfactor::{hemisphere, pairwise, Context};
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;
 use std::path::Path;
 

@@ -5,9 +5,9 @@
 
 use relume::progress::Silent;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
-use relume::radiosity::objects::{object_light, ObjectLight};
+use relume::radiosity::mesh::objects::{object_light, ObjectLight};
+use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::transport::{transport, Bounces, Power, TransportParams};
-use relume::radiosity::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::render::direct::gather_dense;
 use relume::scene::Scene;
 

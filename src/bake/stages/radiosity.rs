@@ -12,7 +12,7 @@ use crate::progress::Progress;
 use crate::radiosity::formfactor::{
     assemble, form_factor_rows, form_factors, shard_rows, Estimator, FormFactors, RowBlock,
 };
-use crate::radiosity::voxelize::{voxelize_noting, Resolution};
+use crate::radiosity::patches::voxelize::{voxelize_noting, Resolution};
 use std::path::PathBuf;
 
 impl StageRun for VoxelizeKnobs {

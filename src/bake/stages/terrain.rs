@@ -7,7 +7,7 @@ use crate::baked::{self, BakeTransaction, StageRecord};
 use crate::error::Result;
 use crate::pipeline::knobs::{HorizonMapsKnobs, MinmaxMipmapKnobs, ThemesKnobs};
 use crate::progress::Progress;
-use crate::terrain::horizon_map::HorizonMap;
+use crate::terrain::horizon::map::HorizonMap;
 use crate::terrain::minmax_mipmap::{level_sizes, MinMaxMipmap};
 
 impl StageRun for MinmaxMipmapKnobs {

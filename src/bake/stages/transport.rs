@@ -9,14 +9,14 @@ use crate::baked::{self, BakeTransaction, StageRecord};
 use crate::error::{Error, Result};
 use crate::pipeline::knobs::TransportKnobs;
 use crate::progress::Progress;
-use crate::radiosity::infinite::{InfiniteFactor, InfiniteSolver};
-use crate::radiosity::lu_panels::{panel_count, Factored, Panel};
-use crate::radiosity::transport::{
-    memory_estimate, transport, Bounces, Transport, TransportParams,
-};
-use crate::radiosity::transport_shard::{
+use crate::radiosity::transport::infinite::{InfiniteFactor, InfiniteSolver};
+use crate::radiosity::transport::lu_panels::{panel_count, Factored, Panel};
+use crate::radiosity::transport::shard::{
     channels as transport_channels, factor_channels, part_memory, part_panels, solve_part,
     Assembly, ChannelFactors, ChannelPart,
+};
+use crate::radiosity::transport::{
+    memory_estimate, transport, Bounces, Transport, TransportParams,
 };
 use std::path::PathBuf;
 

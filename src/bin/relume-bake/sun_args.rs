@@ -4,7 +4,7 @@
 use clap::Args;
 use relume::error::Error;
 use relume::heightmap::{HeightMap, HeightMapInfo};
-use relume::terrain::solar::{solar_position, Instant, Place, SpaOptions};
+use relume::terrain::sun::solar::{solar_position, Instant, Place, SpaOptions};
 use relume::terrain::Sun;
 use relume::Result;
 use serde_json::{json, Value};

@@ -11,7 +11,7 @@ use relume::heightmap::{HeightMap, HeightMapInfo};
 use relume::progress::Progress;
 use relume::render::tonemap::linear_to_srgb8;
 use relume::terrain::generate::{generate, quantise_u16, Shape};
-use relume::terrain::relief::{self, HardMethod};
+use relume::terrain::hard::relief::{self, HardMethod};
 use relume::terrain::soft::{soft_shadow_map, SoftMethod, SoftShadowParams};
 use relume::terrain::Sun;
 use relume::Result;

@@ -12,8 +12,8 @@
 //! receives it, and by reciprocity nothing there could see patch i. Rows of a closed scene sum
 //! to 1 by construction.
 
-use super::{Context, FormFactors};
 use crate::progress::Progress;
+use crate::radiosity::formfactor::{Context, FormFactors};
 use crate::radiosity::geometry::{cosine_direction, item_rng};
 use glam::DVec3;
 use rayon::prelude::*;

@@ -3,7 +3,7 @@
 //!
 //! `F_ij = 1/A_i ∫_{A_i} ∫_{A_j} cosθ_i cosθ_j / (π r²) · V(x, y) dA_j dA_i`
 //!
-//! with visibility V through a BVH of the scene ([`super::visibility`]). Two estimators:
+//! with visibility V through a BVH of the scene ([`crate::raytrace::visibility`]). Two estimators:
 //! [`hemisphere`] shooting (the default: N cosine-distributed rays per patch, `F_ij ≈ hits_j / N`,
 //! rows sum to the unoccluded fraction by construction, cost n·N rays) and [`pairwise`]
 //! area-to-area (N stratified point pairs per patch pair, one visibility ray each, exactly
@@ -16,14 +16,15 @@
 
 pub mod analytic;
 pub mod hemisphere;
+pub mod locate;
 pub mod pairwise;
 pub mod reciprocal;
 
-use super::locate::PatchLocator;
-use super::visibility::Visibility;
-use super::PatchSet;
 use crate::error::{Error, Result};
 use crate::progress::Progress;
+use crate::radiosity::formfactor::locate::PatchLocator;
+use crate::radiosity::PatchSet;
+use crate::raytrace::visibility::Visibility;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;

@@ -17,8 +17,8 @@
 //! one G per pair makes reciprocity `A_i F_ij = A_j F_ji` exact. Pairs with a cosine ≤ 1e-6
 //! (coplanar or facing away) add nothing, so a planar patch has `F_ii = 0` exactly.
 
-use super::{Context, FormFactors};
 use crate::progress::Progress;
+use crate::radiosity::formfactor::{Context, FormFactors};
 use crate::radiosity::geometry::{item_rng, point_to_triangle, AreaSampler, Rng};
 use glam::DVec3;
 use rayon::prelude::*;

@@ -1,6 +1,6 @@
 //! Soft shadows, exact and fast: branch-and-bound over the min/max mipmap (beyond the soft-shadow paper).
 //!
-//! The traversal of [`crate::terrain::accelerated_traversal`] with a continuous criterion: the
+//! The traversal of [`crate::terrain::hard::accelerated_traversal`] with a continuous criterion: the
 //! state is the exact traversal's texel and entry time plus a level; a block is skipped when the
 //! upper bound of the slope of anything it holds ([`slope_upper_bound`] from its max/min height
 //! and the distances at the current entry and the block's exit) is at most the best slope found
@@ -11,11 +11,11 @@
 //! and the lit fraction — equals the exhaustive one (up to the rounding of the bounds, far below
 //! 1e-9 in lit fraction). No recursion, no allocation; the loop is bounded like A2's.
 
-use super::model::{beyond_reach, slope, slope_upper_bound, PixelSun};
 use crate::heightmap::HeightMap;
-use crate::terrain::accelerated_traversal::{block_exit_time, coordinate_after};
-use crate::terrain::exact_traversal::texel_sample;
+use crate::terrain::hard::accelerated_traversal::{block_exit_time, coordinate_after};
+use crate::terrain::hard::exact_traversal::texel_sample;
 use crate::terrain::minmax_mipmap::MinMaxMipmap;
+use crate::terrain::soft::model::{beyond_reach, slope, slope_upper_bound, PixelSun};
 use crate::terrain::sun::Track;
 
 /// Lit fraction of the pixel at (col, row) over `mip` (built from `map`).

@@ -18,11 +18,11 @@
 //! Knobs: `start_level` (clamped to the mipmap's top; −1 = texels) and `intervals` (0 = as many
 //! as reach the map's border or where nothing can matter any more).
 
-use super::model::{beyond_reach, slope, slope_upper_bound, PixelSun};
-use super::uniform::map_exit_time;
 use crate::heightmap::HeightMap;
-use crate::terrain::exact_traversal::texel_sample;
+use crate::terrain::hard::exact_traversal::texel_sample;
 use crate::terrain::minmax_mipmap::MinMaxMipmap;
+use crate::terrain::soft::model::{beyond_reach, slope, slope_upper_bound, PixelSun};
+use crate::terrain::soft::uniform::map_exit_time;
 use crate::terrain::sun::Track;
 
 /// Entry and exit times of block `b` (side 1 << shift) on one axis.

@@ -1,14 +1,14 @@
 //! Soft shadows, the reference: every texel on the track (the exact traversal's texels and
-//! samples, see [`crate::terrain::exact_traversal`]), the largest occluder slope over all of
+//! samples, see [`crate::terrain::hard::exact_traversal`]), the largest occluder slope over all of
 //! them.
 //!
 //! Stops early only when the answer cannot change any more: the disc is fully hidden
 //! (best ≥ slope_dark) or, with `early_stop`, no height of the map can exceed `best` from the
 //! current distance on ([`beyond_reach`] with the map's maximum and minimum).
 
-use super::model::{beyond_reach, slope, PixelSun};
 use crate::heightmap::HeightMap;
-use crate::terrain::exact_traversal::texel_sample;
+use crate::terrain::hard::exact_traversal::texel_sample;
+use crate::terrain::soft::model::{beyond_reach, slope, PixelSun};
 use crate::terrain::sun::Track;
 
 /// Lit fraction of the pixel at (col, row). `range` = (max, min) height of the map.

@@ -14,11 +14,11 @@ pub mod exhaustive;
 pub mod model;
 pub mod uniform;
 
-use super::minmax_mipmap::MinMaxMipmap;
-use super::sun::{Sun, Track};
 use crate::error::{Error, Result};
 use crate::heightmap::HeightMap;
 use crate::progress::Progress;
+use crate::terrain::minmax_mipmap::MinMaxMipmap;
+use crate::terrain::sun::{Sun, Track};
 use model::{SoftSun, SUN_RADIUS_DEG};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

@@ -4,9 +4,9 @@
 //! map's highest point (beyond it nothing can dim the disc: "the ray leaves the terrain
 //! volume"). Samples between texels can miss thin features — that is the baseline's error.
 
-use super::model::{slope, PixelSun};
 use crate::heightmap::HeightMap;
-use crate::terrain::exact_traversal::sample_bilinear;
+use crate::terrain::hard::exact_traversal::sample_bilinear;
+use crate::terrain::soft::model::{slope, PixelSun};
 use crate::terrain::sun::Track;
 
 /// The t at which the track from (px, py) leaves the map.

@@ -1,0 +1,316 @@
+//! Which patch a point on a surface belongs to: the patch of the point's voxel and its
+//! triangle's dominant axis whose pieces are nearest to the point (searching the 26 neighbouring
+//! voxels when the point sits on a voxel boundary). When the voxel holds exactly one patch of that
+//! orientation, that patch is the answer without a distance test. A point under a coplanar cover (the Cornell
+//! ceiling above the light) lies on the cover's piece, so it finds the cover's patch.
+
+use crate::radiosity::geometry::group_key;
+use crate::radiosity::geometry::{self, dominant_axis};
+use crate::radiosity::PatchSet;
+use crate::scene::Scene;
+use glam::DVec3;
+
+/// Distance (grid units) within which a point counts as lying on a patch's piece.
+pub const ON_SURFACE: f64 = 1e-3;
+/// Farthest a hit may lie from every piece and still be assigned (grid units).
+pub const MAX_DISTANCE: f64 = 0.05;
+
+/// Point → patch queries over a [`PatchSet`].
+pub struct PatchLocator {
+    dims: [u32; 3],
+    /// Group key of each patch (non-decreasing: patches are sorted by key).
+    keys: Vec<u64>,
+    /// (first piece, piece count) of each patch.
+    ranges: Vec<(usize, usize)>,
+    /// Vertices and unit normal of each piece.
+    pieces: Vec<(Vec<DVec3>, DVec3)>,
+    /// A bounding sphere (centre, radius) of each piece: the nearest-piece search skips a piece
+    /// that cannot come nearer than the best so far (a patch of a finely meshed statue holds
+    /// hundreds).
+    spheres: Vec<(DVec3, f64)>,
+    /// A sphere holding the spheres of each run of [`CHUNK`] consecutive pieces of a patch;
+    /// patch i's runs start at `chunk_first[i]`.
+    chunks: Vec<(DVec3, f64)>,
+    chunk_first: Vec<usize>,
+    /// Dominant axis of each scene triangle.
+    triangle_axis: Vec<u8>,
+    /// Scene triangle of each piece.
+    piece_triangle: Vec<u32>,
+    /// Dense (first patch, count) per group key when the grid is small enough, else empty (then
+    /// a binary search over `keys`).
+    table: Vec<(u32, u32)>,
+}
+
+/// Pieces per bounding run in the nearest-piece search.
+const CHUNK: usize = 16;
+
+/// Largest grid (voxels × 8 axis slots) that gets a dense lookup table.
+const DENSE_TABLE: u64 = 1 << 24;
+
+impl PatchLocator {
+    pub fn new(set: &PatchSet, scene: &Scene) -> Self {
+        let keys: Vec<u64> = set
+            .patches
+            .iter()
+            .map(|p| group_key(p.voxel, p.axis, set.dims))
+            .collect();
+        let ranges: Vec<(usize, usize)> = set
+            .patches
+            .iter()
+            .map(|p| (p.first_piece as usize, p.piece_count as usize))
+            .collect();
+        let pieces: Vec<(Vec<DVec3>, DVec3)> = set
+            .pieces
+            .iter()
+            .map(|p| {
+                (
+                    p.vertices.iter().map(|&v| DVec3::from(v)).collect(),
+                    DVec3::from(p.normal),
+                )
+            })
+            .collect();
+        let spheres: Vec<(DVec3, f64)> = pieces
+            .iter()
+            .map(|(poly, _)| {
+                let c = poly.iter().sum::<DVec3>() / poly.len().max(1) as f64;
+                let r = poly.iter().map(|&v| (v - c).length()).fold(0.0, f64::max);
+                (c, r)
+            })
+            .collect();
+        let (mut chunks, mut chunk_first) = (Vec::new(), Vec::with_capacity(set.patches.len()));
+        for &(first, count) in &ranges {
+            chunk_first.push(chunks.len());
+            for run in spheres[first..first + count].chunks(CHUNK) {
+                let c = run.iter().map(|s| s.0).sum::<DVec3>() / run.len() as f64;
+                // Rounded up a little, so no piece's sphere pokes out by rounding.
+                let r = run
+                    .iter()
+                    .map(|s| (s.0 - c).length() + s.1)
+                    .fold(0.0, f64::max);
+                chunks.push((c, r * (1.0 + 1e-12) + 1e-12));
+            }
+        }
+        let triangle_axis = (0..scene.triangles.len())
+            .map(|t| {
+                let [a, b, c] = scene.corners(t).map(|v| v.as_dvec3());
+                dominant_axis((b - a).cross(c - a))
+            })
+            .collect();
+        let slots = set.dims.iter().map(|&d| d as u64).product::<u64>() * 8;
+        let mut table = Vec::new();
+        if slots <= DENSE_TABLE {
+            table = vec![(0u32, 0u32); slots as usize];
+            for (i, &k) in keys.iter().enumerate() {
+                let e = &mut table[k as usize];
+                if e.1 == 0 {
+                    e.0 = i as u32;
+                }
+                e.1 += 1;
+            }
+        }
+        PatchLocator {
+            dims: set.dims,
+            keys,
+            ranges,
+            pieces,
+            spheres,
+            chunks,
+            chunk_first,
+            triangle_axis,
+            piece_triangle: set.pieces.iter().map(|p| p.triangle).collect(),
+            table,
+        }
+    }
+
+    /// Dominant axis of scene triangle `t`.
+    pub fn triangle_axis(&self, t: u32) -> u8 {
+        self.triangle_axis[t as usize]
+    }
+
+    /// The patches of a voxel (which may lie outside the grid) with the given axis.
+    pub fn candidates(&self, voxel: [i64; 3], axis: u8) -> std::ops::Range<usize> {
+        if (0..3).any(|a| voxel[a] < 0 || voxel[a] >= self.dims[a] as i64) {
+            return 0..0;
+        }
+        let key = group_key(voxel.map(|v| v as u32), axis, self.dims);
+        if !self.table.is_empty() {
+            let (first, count) = self.table[key as usize];
+            return first as usize..(first + count) as usize;
+        }
+        let lo = self.keys.partition_point(|&k| k < key);
+        let hi = lo + self.keys[lo..].partition_point(|&k| k == key);
+        lo..hi
+    }
+
+    /// The first of patch `i`'s pieces nearest to `p` — (distance, closest point, piece) — or
+    /// (∞, p, 0) when none comes within `bound`. A piece whose bounding sphere lies farther than
+    /// the best so far is skipped: no point of it is nearer than |p − c| − r, and the margin
+    /// (1e-9 grid units, far above the rounding of either side) keeps every piece that could
+    /// tie or win, so the answer is the one a full scan gives.
+    ///
+    /// Pieces are also bounded in runs of [`CHUNK`] (a sphere holding the run's spheres), and
+    /// the run nearest to `p` is searched first so the best tightens at once. Runs are visited
+    /// out of order, so a tie is settled by the lower piece index, as the in-order scan does.
+    fn nearest_piece(&self, p: DVec3, i: usize, bound: f64) -> (f64, DVec3, usize) {
+        let (first, count) = self.ranges[i];
+        let chunks = self.runs(i);
+        let lower = |s: &(DVec3, f64)| beyond(p, s);
+        let start = (0..chunks.len())
+            .min_by(|&a, &b| lower(&chunks[a]).total_cmp(&lower(&chunks[b])))
+            .unwrap_or(0);
+        let mut best = (f64::INFINITY, p, usize::MAX);
+        for run in std::iter::once(start).chain((0..chunks.len()).filter(|&r| r != start)) {
+            if lower(&chunks[run]) > best.0.min(bound) + 1e-9 {
+                continue;
+            }
+            let lo = first + run * CHUNK;
+            for k in lo..(lo + CHUNK).min(first + count) {
+                if lower(&self.spheres[k]) > best.0.min(bound) + 1e-9 {
+                    continue;
+                }
+                let (poly, n) = &self.pieces[k];
+                let q = geometry::closest_point_on_polygon(p, poly, *n);
+                let d = (q - p).length();
+                if d < best.0 || (d == best.0 && k < best.2) {
+                    best = (d, q, k);
+                }
+            }
+        }
+        if best.2 == usize::MAX {
+            best.2 = 0;
+        }
+        best
+    }
+
+    /// Distance from `p` to patch `i`'s pieces, the closest point on them and the unit normal
+    /// of the piece it lies on.
+    pub fn nearest(&self, p: DVec3, i: usize) -> (f64, DVec3, DVec3) {
+        match self.nearest_piece(p, i, f64::INFINITY) {
+            (d, q, k) if d.is_finite() => (d, q, self.pieces[k].1),
+            (d, q, _) => (d, q, DVec3::Z),
+        }
+    }
+
+    /// The patch of `voxel` with `axis` nearest to `p`: (patch, distance, closest point).
+    pub fn nearest_in_voxel(
+        &self,
+        p: DVec3,
+        voxel: [i64; 3],
+        axis: u8,
+    ) -> Option<(u32, f64, DVec3)> {
+        self.nearest_in_voxel_within(p, voxel, axis, f64::INFINITY)
+    }
+
+    /// [`PatchLocator::nearest_in_voxel`] given an upper bound of the answer's distance (the
+    /// same answer: a patch that could reach or tie the nearest is never pruned).
+    fn nearest_in_voxel_within(
+        &self,
+        p: DVec3,
+        voxel: [i64; 3],
+        axis: u8,
+        bound: f64,
+    ) -> Option<(u32, f64, DVec3)> {
+        // Each patch is searched within the nearest distance found so far (a patch that cannot
+        // tie it returns ∞), which changes no answer; the patches are searched in the order of
+        // their nearest run's lower bound, so the bound tightens at the first, and a patch whose
+        // every run lies beyond it is skipped whole. Ties still go to the lower patch index:
+        // a patch that ties the nearest is never pruned, and the minimum is taken over all.
+        let mut bound = bound;
+        let mut order: Vec<(f64, usize)> = self
+            .candidates(voxel, axis)
+            .map(|i| (self.lower_bound(p, i), i))
+            .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        order
+            .into_iter()
+            .map(|(lower, i)| {
+                if lower > bound + 1e-9 {
+                    return (i as u32, f64::INFINITY, p);
+                }
+                let (d, q, _) = self.nearest_piece(p, i, bound);
+                bound = bound.min(d);
+                (i as u32, d, q)
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+    }
+
+    /// A lower bound of the distance from `p` to patch `i`'s pieces: the nearest of its runs'
+    /// spheres.
+    fn lower_bound(&self, p: DVec3, i: usize) -> f64 {
+        self.runs(i)
+            .iter()
+            .map(|s| beyond(p, s))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The bounding spheres of patch `i`'s runs of [`CHUNK`] pieces.
+    fn runs(&self, i: usize) -> &[(DVec3, f64)] {
+        let first = self.chunk_first[i];
+        &self.chunks[first..first + self.ranges[i].1.div_ceil(CHUNK)]
+    }
+
+    /// The patch a point `p` (grid coordinates) on a surface with dominant `axis` belongs to.
+    pub fn locate(&self, p: DVec3, axis: u8) -> Option<u32> {
+        self.locate_on(p, axis, None)
+    }
+
+    /// [`PatchLocator::locate`], where `p` is known to lie on scene triangle `on` (if given):
+    /// the distance to that triangle's pieces in the voxel bounds the nearest-patch search from
+    /// the start, which prunes the other patches' pieces without changing the answer.
+    fn locate_on(&self, p: DVec3, axis: u8, on: Option<u32>) -> Option<u32> {
+        let v = voxel_of(p, self.dims);
+        let own = self.candidates(v, axis);
+        if own.len() == 1 {
+            // The common case: one patch of this orientation in the voxel (several only where a
+            // wall thinner than a voxel separates surfaces; then the nearest one decides).
+            return Some(own.start as u32);
+        }
+        let mut bound = f64::INFINITY;
+        if let Some(t) = on {
+            for i in own {
+                let (first, count) = self.ranges[i];
+                for k in first..first + count {
+                    if self.piece_triangle[k] == t {
+                        let (poly, n) = &self.pieces[k];
+                        let q = geometry::closest_point_on_polygon(p, poly, *n);
+                        bound = bound.min((q - p).length());
+                    }
+                }
+            }
+        }
+        if let Some((i, d, _)) = self.nearest_in_voxel_within(p, v, axis, bound) {
+            if d <= ON_SURFACE {
+                return Some(i);
+            }
+        }
+        let mut best: Option<(u32, f64, DVec3)> = None;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let w = [v[0] + dx, v[1] + dy, v[2] + dz];
+                    if let Some(c) = self.nearest_in_voxel(p, w, axis) {
+                        if best.is_none_or(|b| c.1 < b.1) {
+                            best = Some(c);
+                        }
+                    }
+                }
+            }
+        }
+        best.filter(|b| b.1 <= MAX_DISTANCE).map(|b| b.0)
+    }
+
+    /// The patch of a ray hit on scene triangle `t` at `p`.
+    pub fn locate_hit(&self, p: DVec3, t: u32) -> Option<u32> {
+        self.locate_on(p, self.triangle_axis(t), Some(t))
+    }
+}
+
+/// How far `p` lies beyond a sphere (centre, radius): no point in it is nearer.
+fn beyond(p: DVec3, &(c, r): &(DVec3, f64)) -> f64 {
+    (p - c).length() - r
+}
+
+/// The voxel containing `p` (clamped into the grid).
+pub fn voxel_of(p: DVec3, dims: [u32; 3]) -> [i64; 3] {
+    std::array::from_fn(|a| (p[a].floor() as i64).clamp(0, dims[a] as i64 - 1))
+}
