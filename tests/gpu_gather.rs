@@ -1,6 +1,6 @@
 //! The compressed gather on the GPU (`gather_compressed.wgsl`) against the CPU gather
 //! (`relume::compress::gather`) for every encoding and both decode paths, on the real Cornell
-//! box transport (issue 7: within 1e-4 relative).
+//! box transport (within 1e-4 relative).
 
 mod common;
 
