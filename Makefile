@@ -72,7 +72,7 @@ demo: build
 	@echo "  cornell-sun-frames/frame_000[0-3].png          player: plus a sun turning around it (20°, 110°, 200°, 290°)"
 	@echo "  puget-sound-low-sun-frames/frame_0000.png      player: Puget Sound 2K, themes, Hillaire sky, sun 265°/5°"
 	@echo "  puget-sound-high-sun-frames/frame_0000.png     player: the same view, sun 200°/55°"
-	@echo "  puget-sound-frames/frame_000[0-1].png          player: hard relief shadows, the seed's fog (sun turning)"
+	@echo "  puget-sound-frames/frame_000[0-1].png          player: hard relief shadows, constant-density fog (sun turning)"
 	@echo "  puget-sound-soft-frames/frame_0000.png         player: Puget Sound 2K, soft shadows"
 	@echo "  puget-sound-themes.png                         the theme albedo at 2048² (relume-bake theme)"
 	@echo "  */frames.json                                  adapter and per-pass frame times"

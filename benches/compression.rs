@@ -1,4 +1,4 @@
-//! Compression study (issue 4 "Measure and report"): prints Markdown tables.
+//! Compression study: prints Markdown tables.
 //!
 //! `cargo bench --bench compression` (n = 4056: a closed box with 26x26 patches per wall,
 //! infinite bounces). Environment: `RELUME_BENCH_K` (patches per wall side, default 26),

@@ -1,9 +1,10 @@
-//! Frame times of the freeform casters — the table the seed lost: a plane with 16, 64 and 256
-//! perturbations (`scenes/freeform/bench/terrain-N.ron`) at 640x480 (and, with `--all`, 1280x720
-//! and 1920x1080), by the exact CPU reference, the CPU multilevel caster (affine bound) and the
-//! GPU kernel (`shaders/freeform.wgsl`). Primary rays only (no shading, no shadows), as ratios
-//! against the reference in the same run. On Mesa's lavapipe the "GPU" time is a software
-//! rasteriser's CPU time.
+//! Frame times of the freeform casters — the timing table of Vyatkin et al. (2018), whose values
+//! the extracted text lost: a plane with 16, 64 and 256 perturbations
+//! (`scenes/freeform/bench/terrain-N.ron`) at 640x480 (and, with `--all`, 1280x720 and 1920x1080),
+//! by the exact CPU reference, the CPU multilevel caster (affine bound) and the GPU kernel
+//! (`shaders/freeform.wgsl`). Primary rays only (no shading, no shadows), as ratios against the
+//! reference in the same run. On Mesa's lavapipe the "GPU" time is a software rasteriser's CPU
+//! time.
 //!
 //! `cargo bench --bench freeform_frames [-- --all] [-- --cpu-only] [-- --perturbations N]`
 //! (`--cpu-only` skips the GPU: a 256-perturbation frame at 640x480 takes 20 minutes on

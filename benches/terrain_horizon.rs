@@ -1,8 +1,8 @@
-//! Horizon maps (issue 14, item 2) on Puget Sound: the wall time of `HorizonMap::build` for N
-//! directions at 1K/2K/4K; its accuracy against the exact per-pixel horizon on a subsample
-//! (every 16th row and column at 4K, every 8th below); the cost per direction (texels per
-//! period); and hard shadows from the map for suns between its azimuths against the exact mask
-//! (the certified sweep, equal to the exact traversal on every pixel).
+//! Horizon maps (docs/terrain.md, "Horizon maps") on Puget Sound: the wall time of
+//! `HorizonMap::build` for N directions at 1K/2K/4K; its accuracy against the exact per-pixel
+//! horizon on a subsample (every 16th row and column at 4K, every 8th below); the cost per
+//! direction (texels per period); and hard shadows from the map for suns between its azimuths
+//! against the exact mask (the certified sweep, equal to the exact traversal on every pixel).
 //!
 //! `cargo bench --bench terrain_horizon` (env: RELUME_BENCH_SIZES, default "1024,2048,4096";
 //! RELUME_BENCH_DIRECTIONS, default "16,32,64"; RELUME_BENCH_CHECK=0 checks one pixel only).
@@ -119,8 +119,8 @@ fn main() {
             100.0 * differ as f64 / exact.len() as f64
         );
     }
-    // Sunlight over a day from the same map (issue 14 item 4: "a day at 10-minute steps costs
-    // little more than one horizon pass"): Seattle's summer solstice, hours only and with the
+    // Sunlight over a day from the same map (the goal: "a day at 10-minute steps costs little
+    // more than one horizon pass"): Seattle's summer solstice, hours only and with the
     // clear-sky insolation.
     let date = relume::terrain::sun::solar::Instant::parse("2026-06-21T00:00:00Z").unwrap();
     let place = relume::terrain::sun::solar::Place::new(47.6, -122.3, 0.0).unwrap();

@@ -1,10 +1,9 @@
-//! What fewer sweep lines would cost in accuracy (issue 14, item 2; docs/terrain.md, "Horizon
-//! maps"). The exact sweep runs one line through every pixel centre, so a direction (a, b)
-//! costs |a| + |b| samples per pixel. Timonen & Westerholm's sweep runs about one line per
-//! texel of spacing: for |b| ≥ |a| the lines through the pixel centres of one row (every
-//! |b|-th of the exact family), about (|a| + |b|)/|b| samples per pixel (under 2), and each
-//! pixel takes its horizon from the line that crosses its row nearest to it, up to half a
-//! texel to the side.
+//! What fewer sweep lines would cost in accuracy (docs/terrain.md, "Horizon maps"). The exact sweep
+//! runs one line through every pixel centre, so a direction (a, b) costs |a| + |b| samples per
+//! pixel. Timonen & Westerholm's sweep runs about one line per texel of spacing: for |b| ≥ |a| the
+//! lines through the pixel centres of one row (every |b|-th of the exact family), about (|a| +
+//! |b|)/|b| samples per pixel (under 2), and each pixel takes its horizon from the line that
+//! crosses its row nearest to it, up to half a texel to the side.
 //!
 //! This measures that sideways shift on Puget Sound, per pixel and direction, against the
 //! exact horizon ([`horizon_exact`]): the far samples (beyond D texels along the track) are

@@ -1,5 +1,5 @@
-//! The certified sweep against the memory-read floor (issue 14, item 1): for Puget Sound at
-//! 1K/2K/4K and several sun elevations, the wall time of one pass summing the heights (the
+//! The certified sweep against the memory-read floor (docs/terrain.md, Measurements): for Puget
+//! Sound at 1K/2K/4K and several sun elevations, the wall time of one pass summing the heights (the
 //! floor, best of 5), of the sweep mask (best of 3, mipmap built beforehand and reported on its
 //! own), and of the accelerated traversal (A2); the sweep/floor ratio; how the sweep decided
 //! its pixels; and the pixels where the sweep differs from A2 (which equals the exact traversal

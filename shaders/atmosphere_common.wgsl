@@ -1,8 +1,8 @@
 // Scattered light in the air: the binding-free part shared by the table builders
 // (atmosphere.wgsl, group 0) and the renderer's lookups (atmosphere_lookup.wgsl, group 3):
 // the parameter struct, table sizes, the medium, phase functions, the tables' uv
-// parameterisations, bilinear weights and the seed fog. Nothing here reads a binding; the
-// functions that need the parameters take them (or their radii) as arguments.
+// parameterisations, bilinear weights and the constant-density fog. Nothing here reads a binding;
+// the functions that need the parameters take them (or their radii) as arguments.
 // Kilometres and 1/km; +Y up, the eye at (0, ground + altitude, 0). Tables are storage buffers
 // of vec4 texels, row-major; an axis of N texels covers unit x in [0, 1] with texel i at
 // i / (N - 1). Rust twins: relume::atmosphere::{twin, lut} (same arithmetic, line for line).
@@ -162,8 +162,8 @@ struct Marched {
     transmittance: vec3<f32>,
 }
 
-// The seed's constant-density fog: L0 seen through s km of air with extinction ext and
-// Rayleigh / Mie scattering sr, sm (1/km), Mie g, sun illuminance e, view-sun cosine mu.
+// The constant-density fog (Vyatkin et al. 2018): L0 seen through s km of air with extinction ext
+// and Rayleigh / Mie scattering sr, sm (1/km), Mie g, sun illuminance e, view-sun cosine mu.
 fn fog(l0: vec3<f32>, s: f32, mu: f32, ext: vec3<f32>, sr: vec3<f32>, sm: vec3<f32>, g: f32, e: vec3<f32>) -> vec3<f32> {
     let t = exp(-ext * s);
     let sc = sr * rayleigh_phase(mu) + sm * cornette_shanks_phase(mu, g);

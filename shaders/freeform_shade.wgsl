@@ -16,10 +16,10 @@ struct ShadeFrame {
     size: vec4<u32>,       // width, height, shadows, theme projection (0 none, 1 planar, 2 spherical)
     eye: vec4<f32>,        // xyz eye (world), w: the angle one pixel spans
     projection: vec4<f32>, // planar: min x, min z, max x, max z; spherical: centre xyz
-    air: vec4<u32>,        // model (0 none, 1/2 seed fog per pixel, 3 Hillaire), unused x3
+    air: vec4<u32>,        // model (0 none, 1/2 fog per pixel, 3 Hillaire), unused x3
     air_scale: vec4<f32>,  // km per scene unit, unused x3
     sun_light: vec4<f32>,  // the sun's colour on surfaces (rgb), unused
-    fog_ext: vec4<f32>,    // seed model: extinction per km (rgb), w: Mie g
+    fog_ext: vec4<f32>,    // constant-density fog: extinction per km (rgb), w: Mie g
     fog_rayleigh: vec4<f32>,
     fog_mie: vec4<f32>,
     fog_sun: vec4<f32>,    // sun illuminance lighting the air (rgb), w: radiance scale (pi)

@@ -1,7 +1,7 @@
-// Indirect exitance B = S·E straight from the compressed transport (issue 4's format): the
-// dense part decoded block by block — by the texture unit (hardware BC1/BC6H) or by the WGSL
-// decoders below over a storage buffer (BC1, BC4, F16, F32) — plus the sparse sidecar, with the
-// reordering undone (E'[k] = E[perm[k]], B[perm[k]] = B'[k]).
+// Indirect exitance B = S·E straight from the compressed transport (the format of
+// docs/compression.md): the dense part decoded block by block — by the texture unit (hardware
+// BC1/BC6H) or by the WGSL decoders below over a storage buffer (BC1, BC4, F16, F32) — plus the
+// sparse sidecar, with the reordering undone (E'[k] = E[perm[k]], B[perm[k]] = B'[k]).
 // Rust twin: relume::compress::gather (CPU), whose block decoders these mirror
 // (compress::bc1::decode_block, compress::blocks::bc4_palette, compress::dense::decode_block_at).
 //

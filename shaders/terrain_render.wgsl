@@ -15,7 +15,7 @@ struct TerrainFrame {
     sun: vec4<f32>,            // toward the sun in map space (x east, y north, z up); w = k_shadow
     cell: vec4<f32>,           // cell_x, cell_y, vertical exaggeration, grid step (texels)
     sun_light: vec4<f32>,      // sun irradiance reaching the terrain (RGB), w: sky (ambient) term
-    fog_ext: vec4<f32>,        // seed model: extinction per km (RGB), w: Mie g
+    fog_ext: vec4<f32>,        // constant-density fog: extinction per km (RGB), w: Mie g
     fog_rayleigh: vec4<f32>,   // Rayleigh scattering per km (RGB), w: unused
     fog_mie: vec4<f32>,        // Mie scattering per km (RGB), w: unused
     fog_sun: vec4<f32>,        // sun illuminance lighting the air (RGB), w: radiance scale (π)
@@ -23,7 +23,7 @@ struct TerrainFrame {
     flags: u32,                // bit 0 shadows, bit 1 air, bit 2 soft shadows, bit 3 horizon maps, bit 4 themes
     min_height: f32,
     max_height_tint: f32,
-    model: u32,                // 1 seed fog per vertex, 2 per pixel, 3 Hillaire (with bit 1 set)
+    model: u32,                // 1 fog per vertex, 2 per pixel, 3 Hillaire (with bit 1 set)
     pad0: u32,
     pad1: u32,
     pad2: u32,
@@ -39,7 +39,7 @@ struct VOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) texel: vec2<f32>,
     @location(1) world: vec3<f32>,
-    // Per-vertex seed fog: in-scattered radiance (rgb) and transmittance (rgb).
+    // Per-vertex constant-density fog: in-scattered radiance (rgb) and transmittance (rgb).
     @location(2) fog_in: vec3<f32>,
     @location(3) fog_t: vec3<f32>,
 }
@@ -49,8 +49,8 @@ fn sun_world() -> vec3<f32> {
     return vec3<f32>(frame.sun.x, frame.sun.z, -frame.sun.y);
 }
 
-// The seed's constant-density model over the segment eye → world: (in-scattered, transmittance)
-// in the terrain's radiance units (× frame.fog_sun.w).
+// The constant-density fog (Vyatkin et al. 2018) over the segment eye → world: (in-scattered,
+// transmittance) in the terrain's radiance units (× frame.fog_sun.w).
 fn seed_fog(world: vec3<f32>) -> array<vec3<f32>, 2> {
     let to_p = world - frame.eye.xyz;
     let s_km = length(to_p) * 1e-3;
@@ -191,7 +191,7 @@ fn fs_sky(v: SkyOut) -> @location(0) vec4<f32> {
     if (frame.model == 3u) {
         rgb = sky_radiance(dir) * frame.fog_sun.w;
     } else {
-        // The seed model's limit s → ∞: E_sun·(β_sc·Φ)/β_ext.
+        // The constant-density fog's limit s → ∞: E_sun·(β_sc·Φ)/β_ext.
         let mu = dot(dir, sun_world());
         rgb = fog(vec3<f32>(0.0), 1e9, mu, frame.fog_ext.xyz, frame.fog_rayleigh.xyz,
             frame.fog_mie.xyz, frame.fog_ext.w, frame.fog_sun.xyz) * frame.fog_sun.w;

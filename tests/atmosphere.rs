@@ -1,6 +1,7 @@
-//! Scattered light on the CPU: the seed's fog in its limits, the reference (quadrature and
-//! Monte Carlo) against analytic values and an independent Simpson rule, and Hillaire's
-//! tables and the seed's model against the reference from a high sun to one below the horizon.
+//! Scattered light on the CPU: the constant-density fog of Vyatkin et al. (2018) in its limits, the
+//! reference (quadrature and Monte Carlo) against analytic values and an independent Simpson rule,
+//! and Hillaire's tables and the constant-density fog against the reference from a high sun to one
+//! below the horizon.
 
 // Per-channel loops index several RGB arrays at once.
 #![allow(clippy::needless_range_loop)]
@@ -265,18 +266,18 @@ fn hillaire_and_the_seed_against_the_reference_by_sun_elevation() {
     for (k, r) in rows.iter().enumerate() {
         assert!(r.hillaire_aerial < 1.25e-2 * aerial[k], "{r:?}");
         assert!(r.hillaire_sky < 1.25e-2 * sky[k], "{r:?}");
-        // Hillaire's tables beat the seed everywhere on the segments.
+        // Hillaire's tables beat the constant-density fog everywhere on the segments.
         assert!(r.hillaire_aerial < r.fog, "{r:?}");
     }
-    // "If the Sun is not too low": the seed against what it models (single scattering)
-    // stays within 30 % down to 60° (measured 25.1 % at 90°, 29.4 % at 60°, 55.9 % at 30°);
-    // attenuating its sun keeps it within 20 % down to 60° (9.5, 12.0, then 22.8 % at 30°).
+    // "If the Sun is not too low" (Vyatkin et al. 2018): the fog against what it models (single
+    // scattering) stays within 30 % down to 60° (measured 25.1 % at 90°, 29.4 % at 60°, 55.9 % at
+    // 30°); attenuating its sun keeps it within 20 % down to 60° (9.5, 12.0, then 22.8 % at 30°).
     assert_eq!(lowest_within(&rows, |r| r.fog_vs_single, 0.3), Some(60.0));
     assert_eq!(
         lowest_within(&rows, |r| r.fog_attenuated_vs_single, 0.2),
         Some(60.0)
     );
-    // Against the full reference the seed is never within 30 %: it lacks multiple scattering
+    // Against the full reference the fog is never within 30 %: it lacks multiple scattering
     // (45–61 % at and above 15°).
     assert_eq!(lowest_within(&rows, |r| r.fog, 0.3), None);
     // Hillaire's sky view stays within 20 % down to 0° (measured 15.7 % at 2°, 27.8 % at −2°).

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
 
-/// The corpus must stay at least this large (issue 15).
+/// The corpus must stay at least this large.
 const MIN_CASES: usize = 40;
 
 #[derive(Deserialize, Clone, Copy, Debug, Default, PartialEq)]

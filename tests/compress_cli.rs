@@ -306,8 +306,9 @@ fn bad_encode_knobs_and_missing_transport_are_errors() {
 
 #[test]
 fn default_encode_meets_the_goal_on_the_box() {
-    // Issue 4's goal: ≤ 2 % RMS relative error of the gathered light at ≤ 1.5x the bytes of the
-    // radiosity thesis's scheme (Bc1Log, p = 4 %), here on the small box and the standard lights.
+    // The goal: ≤ 2 % RMS relative error of the gathered light at ≤ 1.5x the bytes of the
+    // scheme of Shcherbakov (2017) (Bc1Log, p = 4 %), here on the small box and the standard
+    // lights.
     let tmp = tempfile::tempdir().unwrap();
     let s = transport_box::transport(&transport_box::closed_box(8, 2), None); // n = 384
     let dir = bake_with_transport(tmp.path(), "b", &s);

@@ -1,4 +1,4 @@
-//! Compression library: exactness, extremes, laws (issue 4 "Tests").
+//! Compression library: exactness, extremes, laws.
 #![allow(clippy::needless_range_loop)]
 
 #[path = "support/transport_box.rs"]

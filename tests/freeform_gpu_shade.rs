@@ -26,8 +26,8 @@ fn gpu_shadows_and_shading_return_the_twins() {
     let caster = FreeformCaster::new(&gpu).unwrap();
     let mut shader = FreeformShader::new(&gpu).unwrap();
     let params = RmlrcParams::default();
-    // The air scene once per shader branch (the seed's per-vertex model is evaluated per pixel
-    // on freeform surfaces: the same branch as per pixel).
+    // The air scene once per shader branch (the per-vertex constant-density fog is evaluated per
+    // pixel on freeform surfaces: the same branch as per pixel).
     for (name, model) in [
         ("csg-holes.ron", None),
         ("terrain-16.ron", None),

@@ -1,6 +1,6 @@
 //! The compressed gather on the GPU (`gather_compressed.wgsl`) against the CPU gather
 //! (`relume::compress::gather`) for every encoding and both decode paths, on the real Cornell
-//! box transport (issue 7: within 1e-4 relative).
+//! box transport (within 1e-4 relative).
 
 mod common;
 
@@ -67,7 +67,7 @@ fn cpu_gather(t: &EncodedTransport, e: &[[f32; 3]]) -> Vec<[f32; 3]> {
 }
 
 /// Max |GPU − CPU| over all patches and channels relative to the largest value, and the RMS
-/// relative difference ‖GPU − CPU‖₂ / ‖CPU‖₂ (the issue's gather-error measure).
+/// relative difference ‖GPU − CPU‖₂ / ‖CPU‖₂ (the gather-error measure of docs/compression.md).
 fn differences(gpu: &[[f32; 3]], cpu: &[[f32; 3]], what: &str) -> (f64, f64) {
     let scale = cpu.iter().flatten().fold(0.0f32, |m, v| m.max(v.abs())) as f64;
     assert!(scale > 0.0, "{what}: the gathered light is zero");

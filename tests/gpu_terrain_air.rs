@@ -1,10 +1,11 @@
 //! A terrain frame seen through the air (`terrain_render.wgsl` with `gpu::terrain_air`) against
 //! an independent CPU rendering of the same frame: a flat 64 km square seen in perspective,
 //! each pixel's ray cut with the ground plane on the CPU (not rasterised), lit as the shader
-//! lights it, then the seed's fog in f64 (`atmosphere::fog::FogParams`) or Hillaire's tables by
-//! their CPU twin (`atmosphere::lut::Luts`), and the sky by the same model. This checks the
-//! wiring the kernel twins cannot: units (km), the π of the shading convention, the frames of
-//! the view and sun directions, the sun lighting the ground, and where the sky is drawn.
+//! lights it, then the constant-density fog of Vyatkin et al. (2018) in f64
+//! (`atmosphere::fog::FogParams`) or Hillaire's tables by their CPU twin (`atmosphere::lut::Luts`),
+//! and the sky by the same model. This checks the wiring the kernel twins cannot: units (km), the π
+//! of the shading convention, the frames of the view and sun directions, the sun lighting the
+//! ground, and where the sky is drawn.
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! Files relume writes, read by decoders not written here (issue 15): the BC1, BC4 and BC6H
+//! Files relume writes, read by decoders not written here: the BC1, BC4 and BC6H
 //! blocks of `transfer.dds` by `texture2ddecoder` (PyPI; Perfare's Texture2DDecoder, the C++
 //! decoders of AssetStudio), headless player frames and shadow masks by Pillow. The DDS header
 //! is parsed in Python from the DDS specification, not by relume or `ddsfile`. (KTX2 is read by

@@ -130,9 +130,9 @@ fn adaptive_patches_are_the_same_for_any_thread_count() {
 /// uniform grid and adaptive patches side by side (the full curve: `relume-bake study radiosity
 /// --scene scenes/generated/door-ajar.obj --objects-reference tests/reference/door-ajar.mitsuba.json
 /// --sweeps objects`). Adaptive's worst channel is below the uniform grid's (measured 5.3 % vs
-/// 9.4 %), and adaptive brings every object within 5 % (mean over RGB, issue 19's bar; measured
-/// worst 4.88 %, the dark cabinet; the uniform grid misses it on 2 of 11 objects, worst 8.2 %).
-/// The bake is seeded and thread-count independent, so the figure reproduces exactly.
+/// 9.4 %), and adaptive brings every object within 5 % (mean over RGB, the bar set for adaptive
+/// patches; measured worst 4.88 %, the dark cabinet; the uniform grid misses it on 2 of 11 objects,
+/// worst 8.2 %). The bake is seeded and thread-count independent, so the figure reproduces exactly.
 #[test]
 fn adaptive_patches_come_closer_to_mitsuba_on_the_door_ajar() {
     let reference: Value = serde_json::from_str(

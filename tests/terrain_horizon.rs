@@ -181,8 +181,8 @@ fn f32_map_is_the_exact_sweep_within_rounding() {
         }
     }
     eprintln!("largest excess over half a step: {excess:.3e}°");
-    // Measured: 1.97e-3° with the directions of stop 43 (azimuth tolerance 0.2; the
-    // lidar-like map's cliffs, above), 1.18e-3° with today's (0.3).
+    // Measured: 1.97e-3° with directions chosen at azimuth tolerance 0.2 (the lidar-like map's
+    // cliffs, above), 1.18e-3° with the current tolerance (0.3).
     assert!(excess <= F32_ROUNDING_DEG, "{excess}°");
 }
 

@@ -1,4 +1,4 @@
-//! Thematic textures (issue 13, docs/themes.md): borders, animation, index mips, compression,
+//! Thematic textures (docs/themes.md): borders, animation, index mips, compression,
 //! tiling, loaders and the `theme` command — each against an independent brute-force value.
 
 mod common;

@@ -1,5 +1,5 @@
 #!/bin/sh
-# GRASS r.sunmask side by side with relume-bake shadow (issue 14, item 7).
+# GRASS r.sunmask side by side with relume-bake shadow.
 #
 # Crops a 512x512 window of the bundled SRTM DEM (UTM 11N, 30 m), runs GRASS's r.sunmask and
 # relume's three hard-shadow methods on it for one sun, and prints the times, their ratio, and

@@ -1,4 +1,4 @@
-//! The seed's constant-density model (Hoffman & Preetham 2002):
+//! The constant-density fog of Vyatkin et al. (2018), the model of Hoffman & Preetham (2002):
 //!
 //! `L = L0·e^(−β_ext·s) + E_sun·(β_sc·Φ(θ)/β_ext)·(1 − e^(−β_ext·s))`
 //!
@@ -6,11 +6,11 @@
 //! surface) and the sun. The coefficients are the air's at the **eye's altitude**: β_ext =
 //! Rayleigh + Mie extinction + ozone, β_sc·Φ = β_R·Φ_R(θ) + β_M·Φ_CS(θ) (so the phase is the
 //! scattering-weighted mix, per channel). E_sun is the sun's illuminance **unattenuated** — the
-//! seed's choice, which is why it fails for low suns; [`FogParams::new`] can instead attenuate
+//! paper's choice, which is why it fails for low suns; [`FogParams::new`] can instead attenuate
 //! it by the air between the eye and the sun (and zero it below the horizon), a variant the
-//! study reports beside the seed. Single scattering only, no ground, flat density.
+//! study reports beside the paper's. Single scattering only, no ground, flat density.
 //!
-//! *Per vertex* (the seed): the model is evaluated at the vertices of a triangle and the
+//! *Per vertex* (as in the paper): the model is evaluated at the vertices of a triangle and the
 //! result interpolated linearly; [`per_vertex`] reproduces that along one edge so the study
 //! can measure it against the per-pixel evaluation [`per_pixel`].
 
@@ -31,9 +31,9 @@ pub struct FogParams {
 }
 
 impl FogParams {
-    /// The air at the eye's altitude `eye_altitude` (m). `attenuate_sun` false is the seed
-    /// (E_sun as at the top of the air); true multiplies it by the transmittance from the eye
-    /// to the sun (zero when the planet hides the sun).
+    /// The air at the eye's altitude `eye_altitude` (m). `attenuate_sun` false is the
+    /// paper's model (E_sun as at the top of the air); true multiplies it by the transmittance from
+    /// the eye to the sun (zero when the planet hides the sun).
     pub fn new(atm: &Atmosphere, eye_altitude: f64, sun_dir: DVec3, attenuate_sun: bool) -> Self {
         let m = atm.medium(eye_altitude);
         let sun_t = if attenuate_sun {

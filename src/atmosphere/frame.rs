@@ -4,8 +4,8 @@
 //!
 //! Units: surfaces are shaded as albedo × (E·cos + sky), without the 1/π of a Lambertian
 //! surface, so the air's radiance is multiplied by π (`fog_sun.w`) to match. The sun lighting
-//! surfaces is the top-of-air sun for the seed's model (its assumption) and, for Hillaire's,
-//! the sun seen through the air from the ground's altitude (f64 quadrature,
+//! surfaces is the top-of-air sun for the constant-density fog (its assumption) and, for
+//! Hillaire's, the sun seen through the air from the ground's altitude (f64 quadrature,
 //! `reference::sun_transmittance`): low suns redden and dim.
 
 use super::fog::FogParams;
@@ -17,7 +17,7 @@ use glam::DVec3;
 pub struct AirFrame {
     /// RGB: the sun's illuminance on surfaces (× strength); w: the sky (ambient) term.
     pub sun_light: [f32; 4],
-    /// The seed model: extinction per km (RGB), w: Mie g.
+    /// The constant-density fog: extinction per km (RGB), w: Mie g.
     pub fog_ext: [f32; 4],
     /// Rayleigh scattering per km (RGB).
     pub fog_rayleigh: [f32; 4],
@@ -25,7 +25,7 @@ pub struct AirFrame {
     pub fog_mie: [f32; 4],
     /// Sun illuminance lighting the air (RGB), w: the radiance scale (π).
     pub fog_sun: [f32; 4],
-    /// 0 none, 1 seed fog per vertex, 2 per pixel, 3 Hillaire.
+    /// 0 none, 1 constant-density fog per vertex, 2 per pixel, 3 Hillaire.
     pub model: u32,
 }
 
@@ -81,8 +81,8 @@ pub fn air_frame(
 }
 
 impl Model {
-    /// The shaders' number for the model: 0 none, 1 seed fog per vertex, 2 per pixel, 3
-    /// Hillaire.
+    /// The shaders' number for the model: 0 none, 1 constant-density fog per
+    /// vertex, 2 per pixel, 3 Hillaire.
     pub fn code(self) -> u32 {
         match self {
             Model::None => 0,

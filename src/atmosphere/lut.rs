@@ -456,9 +456,9 @@ impl Luts {
     }
 }
 
-/// The seed's fog in f32 (the twin of `fog` in WGSL): radiance of `l0` seen through `s` km of
-/// constant air with extinction `ext`, Rayleigh and Mie scattering `sr`, `sm` (1/km), Mie g,
-/// sun illuminance `e`, view–sun cosine `mu`.
+/// The constant-density fog (Vyatkin et al. 2018) in f32 (the twin of `fog` in WGSL): radiance of
+/// `l0` seen through `s` km of constant air with extinction `ext`, Rayleigh and Mie scattering
+/// `sr`, `sm` (1/km), Mie g, sun illuminance `e`, view–sun cosine `mu`.
 #[allow(clippy::too_many_arguments)]
 pub fn fog(l0: Vec3, s: f32, mu: f32, ext: Vec3, sr: Vec3, sm: Vec3, g: f32, e: Vec3) -> Vec3 {
     let t = (-ext * s).exp();

@@ -1,7 +1,8 @@
-//! Scattered light in the air (aerial perspective and sky): the seed's constant-density fog
-//! (Hoffman & Preetham 2002), Hillaire 2020's look-up tables (transmittance, multiple
-//! scattering, sky view, aerial perspective), and the f64 reference they are measured against
-//! (quadrature single scattering plus a Monte Carlo path tracer for every order).
+//! Scattered light in the air (aerial perspective and sky): the constant-density fog of Vyatkin
+//! et al. (2018) (the model of Hoffman & Preetham 2002), Hillaire 2020's look-up tables
+//! (transmittance, multiple scattering, sky view, aerial perspective), and the f64 reference they
+//! are measured against (quadrature single scattering plus a Monte Carlo path tracer for every
+//! order).
 //!
 //! Plain data only (layer 3): an [`Atmosphere`] (SI units, metres), positions given as an
 //! altitude above the ground sphere, directions in the eye's local frame with **+Y up** (the
@@ -9,8 +10,8 @@
 //! [`Atmosphere::ground_radius`] (default 6,371 km, the radius curved terrain uses; Hillaire
 //! uses 6,360 km) with the air up to [`Atmosphere::top_radius`] (ground + 100 km).
 //!
-//! Files: `fog.rs` (seed model, per pixel and per vertex), `frame.rs` (the air's uniform fields
-//! of a rendered frame), `reference.rs` (quadrature),
+//! Files: `fog.rs` (constant-density fog, per pixel and per vertex), `frame.rs` (the air's uniform
+//! fields of a rendered frame), `reference.rs` (quadrature),
 //! `monte_carlo.rs` (path tracer), `twin.rs` (the f32 parameters shared with
 //! `shaders/atmosphere.wgsl`, parameterisations, filtering), `lut.rs` (building the tables and
 //! the lookups a renderer calls), `study.rs` (error against sun elevation).

@@ -67,12 +67,12 @@ pub struct Row {
     pub hillaire_march: f64,
     /// Hillaire: the sky-view table, on the sky directions.
     pub hillaire_sky: f64,
-    /// The seed's constant-density model (E_sun unattenuated), on the segments.
+    /// The constant-density fog of Vyatkin et al. 2018 (E_sun unattenuated), on the segments.
     pub fog: f64,
     /// The same with E_sun attenuated by the air between the eye and the sun.
     pub fog_attenuated_sun: f64,
-    /// The seed against the reference's single scattering only (what the seed models: the
-    /// error of its constant density and unattenuated sun alone).
+    /// The constant-density fog against the reference's single scattering only (what the fog
+    /// models: the error of its constant density and unattenuated sun alone).
     pub fog_vs_single: f64,
     /// The attenuated-sun variant against single scattering only.
     pub fog_attenuated_vs_single: f64,

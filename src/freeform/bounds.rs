@@ -6,7 +6,7 @@
 //!
 //! Two bounds of the field over such a cell:
 //! - [`Bound::Interval`]: natural interval arithmetic over the cell's axis-aligned box — the
-//!   baseline the seed implies;
+//!   baseline Vyatkin et al. (2018) imply;
 //! - [`Bound::Affine`]: affine arithmetic over the five noise symbols (Knoll et al. 2009): a
 //!   quadric is evaluated exactly up to its quadratic remainder, `max(q, 0)³` by its Chebyshev
 //!   linear approximation, so the base surface and its perturbations keep their first-order

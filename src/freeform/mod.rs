@@ -1,5 +1,5 @@
-//! Function-based geometry (seed 001, first half): freeform surfaces — a base quadric plus
-//! perturbation functions `gᵢ·max(Qᵢ, 0)³`, combined by min/max — ray cast without ever being
+//! Function-based geometry (Vyatkin et al. 2018, first half): freeform surfaces — a base quadric
+//! plus perturbation functions `gᵢ·max(Qᵢ, 0)³`, combined by min/max — ray cast without ever being
 //! tessellated.
 //!
 //! - [`field`]: the compiled field (world quadrics, perturbations, the CSG program);

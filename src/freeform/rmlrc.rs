@@ -1,4 +1,4 @@
-//! Recursive multilevel ray casting (the seed's RMLRC), level by level.
+//! Recursive multilevel ray casting (RMLRC, Vyatkin et al. 2018), level by level.
 //!
 //! The screen is covered by square tiles of `2^top` pixels. Each tile carries a log-depth range
 //! `[s_lo, s_hi]` that holds the first surface point of every pixel ray under it. A level's pass

@@ -176,7 +176,7 @@ pub struct EncodeKnobs {
     pub containers: Vec<Container>,
 }
 
-/// The default encoding: BC6H with filled holes and a 1 % sidecar reached the goal
+/// The default encoding: BC6H with filled holes and a 1 % sidecar reached the goal
 /// (≤ 2 % RMS relative gather error at ≤ 1.5x the bytes of the radiosity thesis's scheme) by a wide margin; see
 /// docs/compression.md for the measurements.
 fn default_encoding() -> DenseEncoding {

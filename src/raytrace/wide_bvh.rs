@@ -125,7 +125,7 @@ impl WideBvh {
     /// children (the first visited next, the others pushed last slot first, so popped in slot
     /// order). A larger box is more likely to hold what stops the ray; on the furnished room
     /// this order made occlusion 8–10 % faster than the collapse's own child order
-    /// (docs/radiosity.md, stop 46).
+    /// (docs/radiosity.md, form_factors, "the largest box first").
     pub fn any(&self, ray: &BoxRay, tmin: f32, tmax: f32, leaf: &mut impl AnyLeaf) -> bool {
         if self.root == EMPTY {
             return false;

@@ -42,8 +42,9 @@ fn v3(a: [f32; 4]) -> Vec3 {
 /// Linear radiance `rgb` of a surface at distance `t` (scene units) along the unit ray `d` —
 /// or, with `t` None, of the background where the ray missed — as seen through the air, the
 /// sun toward unit `sun`: twin of `through_air` in `shaders/freeform_shade.wgsl`. Surfaces:
-/// `rgb·T + L_in·π` over t·km_per_unit; misses: the sky (the seed model's s → ∞ limit, or
-/// Hillaire's sky view). The seed's per-vertex model is evaluated per pixel (no vertices).
+/// `rgb·T + L_in·π` over t·km_per_unit; misses: the sky (the constant-density fog's s → ∞
+/// limit, or Hillaire's sky view). The fog of Vyatkin et al. (2018), a per-vertex model, is
+/// evaluated per pixel (no vertices).
 pub fn through_air(
     rgb: [f32; 3],
     d: [f32; 3],

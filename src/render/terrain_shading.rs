@@ -28,8 +28,8 @@ pub struct TerrainSettings {
     /// Thematic textures (docs/themes.md) instead of the hypsometric tint when the bake has a
     /// theme set.
     pub themes: bool,
-    /// Scattered light on the terrain and in the sky (docs/atmosphere.md): the seed's fog per
-    /// vertex or per pixel, Hillaire's tables, or none.
+    /// Scattered light on the terrain and in the sky (docs/atmosphere.md): the constant-density
+    /// fog of Vyatkin et al. (2018) per vertex or per pixel, Hillaire's tables, or none.
     pub atmosphere: crate::atmosphere::Model,
     /// Sun irradiance scale.
     pub sun_strength: f32,

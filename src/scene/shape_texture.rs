@@ -5,10 +5,10 @@
 use super::freeform::{default_color, default_specular, finite3, positive};
 use serde::{Deserialize, Serialize};
 
-/// A shape texture (the seed's "shape textures"): the carrier surface displaced along its unit
-/// normal by `height_scale ×` the bilinear interpolation of a height grid, optionally morphed
-/// toward a second grid. Solid is below the displaced surface. Only the deviation from the
-/// carrier is stored.
+/// A shape texture (the "shape textures" of Vyatkin et al. 2018): the carrier surface displaced
+/// along its unit normal by `height_scale ×` the bilinear interpolation of a height grid,
+/// optionally morphed toward a second grid. Solid is below the displaced surface. Only the
+/// deviation from the carrier is stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TexturedSurface {

@@ -1,9 +1,9 @@
-//! Scattered-light study (docs/atmosphere.md): the in-scattering error of the seed's fog and of
-//! Hillaire's tables against sun elevation, from `atmosphere::study::error_vs_elevation` (the
-//! reference: f64 quadrature single scattering + Monte Carlo orders ≥ 2). One sweep; a setting
-//! per (model, sun elevation), its error the largest relative error over the views and RGB.
-//! The plot is log–log like every study plot, so suns at or below the horizon appear in the
-//! table only.
+//! Scattered-light study (docs/atmosphere.md): the in-scattering error of the constant-density
+//! fog of Vyatkin et al. (2018) and of Hillaire's tables against sun elevation, from
+//! `atmosphere::study::error_vs_elevation` (the reference: f64 quadrature single scattering + Monte
+//! Carlo orders ≥ 2). One sweep; a setting per (model, sun elevation), its error the largest
+//! relative error over the views and RGB. The plot is log–log like every study plot, so suns at or
+//! below the horizon appear in the table only.
 
 use super::{Column, Format, Measure, PlotSpec, Setting, Sweep};
 use crate::atmosphere::study::{error_vs_elevation, Row, Views};

@@ -1,6 +1,6 @@
-//! Colour Cell Compression of a class-index map (Campbell et al. 1986, cited by the seed for
-//! "up to six times"): per 4×4 block two classes and a 16-bit mask choosing between them, one
-//! 32-bit word per 16 texels — 2 bits per texel instead of 8, random access in one fetch.
+//! Colour Cell Compression of a class-index map (Campbell et al. 1986, cited by Vyatkin et
+//! al. 2018 for "up to six times"): per 4×4 block two classes and a 16-bit mask choosing between
+//! them, one 32-bit word per 16 texels — 2 bits per texel instead of 8, random access in one fetch.
 //!
 //! Plain CCC is lossy where three or more classes meet in a block (the extra classes take the
 //! block's most frequent one). Index maps are made of large contiguous regions, so such blocks

@@ -1,5 +1,5 @@
-//! The class-index map (the seed's "service buffer" of pointers to themes and border kinds),
-//! made one of three ways:
+//! The class-index map (the "service buffer" of pointers to themes and border kinds of
+//! Vyatkin et al. 2018), made one of three ways:
 //! - by rules over a height map ([`from_rules`]): height, slope and aspect per texel, the first
 //!   matching rule wins (water below a level, sand, forest, rock, snow);
 //! - from an image ([`from_keys`]): each pixel's colour (grey or RGB) names a class;

@@ -1,5 +1,5 @@
-//! Mip levels of a class-index map. Indices cannot be blended like colours (the seed, §V): a
-//! texel of level l keeps the class that wholly covers its 2^l × 2^l footprint of level 0;
+//! Mip levels of a class-index map. Indices cannot be blended like colours (Vyatkin et al. 2018,
+//! §V): a texel of level l keeps the class that wholly covers its 2^l × 2^l footprint of level 0;
 //! where no class does, it keeps the class that covers most of the footprint (ties → the
 //! smaller index), so details smaller than the texel are dropped and no level ever holds a
 //! class absent from the texels it covers. A lone one-texel island vanishes at level 1, where

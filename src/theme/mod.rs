@@ -1,9 +1,9 @@
-//! Thematic textures (the function-based geometry paper, seed 001 §V; docs/themes.md): large
+//! Thematic textures (Vyatkin et al. 2018, §V; docs/themes.md): large
 //! areas textured from little memory. A map of *class* indices (each class = a theme and a
 //! border kind), a small tileable texture per theme, and a turbulence map that perturbs the
 //! index lookup — borders come out fractal, and shifting the noise per frame animates them.
 //!
-//! Per texel, as the seed does ([`compose::albedo`], twin of `theme_albedo` in
+//! Per texel, as Vyatkin et al. (2018) do ([`compose::albedo`], twin of `theme_albedo` in
 //! `shaders/theme.wgsl`): read the border traits of the class at uv, scale uv by the border's
 //! frequency, fetch the noise, multiply by the amplitude, offset uv, fetch the class index at
 //! the offset uv, fetch its theme's texel (with a static in-region noise offset that breaks the
@@ -29,7 +29,7 @@ pub mod textures;
 
 use serde::{Deserialize, Serialize};
 
-/// How the border of a class's region is drawn (the seed's boundary kinds).
+/// How the border of a class's region is drawn (the boundary kinds of Vyatkin et al. 2018).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Border {
     /// The index lookup is displaced by turbulence: `amplitude` in index-map texels (the most

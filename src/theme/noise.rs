@@ -3,8 +3,8 @@
 //!
 //! Each channel is a sum of `octaves` periodic gradient-noise (Perlin) octaves over the unit
 //! square: octave k has `base_period · 2^k` lattice cells per side and amplitude 2^-k, so the
-//! higher spatial frequencies have the smaller amplitude, the spectrum the seed asks of
-//! "turbulent noise". The lattice gradients are hashed modulo the octave's period, so the sum is
+//! higher spatial frequencies have the smaller amplitude, the spectrum Vyatkin et al. (2018) ask
+//! of "turbulent noise". The lattice gradients are hashed modulo the octave's period, so the sum is
 //! exactly periodic with period 1 and the map wraps without a seam. The channels are scaled
 //! together so that the largest |value| over the map is 1: an amplitude A then displaces by at
 //! most A. (Perlin's "turbulence" sums |noise|, which is never negative; a displacement needs
