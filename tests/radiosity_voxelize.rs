@@ -168,7 +168,6 @@ fn transfer_weights_are_convex_and_orientation_compatible() {
 #[test]
 fn corner_lists_equal_weighting_each_corner_alone() {
     use relume::radiosity::patches::corners::PointTransfer;
-    use relume::raytrace::visibility::Visibility;
     let scene = relume::scene::load_scene(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/generated/door-ajar.obj"),
         Default::default(),
@@ -176,7 +175,7 @@ fn corner_lists_equal_weighting_each_corner_alone() {
     .unwrap()
     .0;
     let set = patches(&scene, Resolution::TargetPatches(800));
-    let vis = Visibility::for_patches(&scene, &set);
+    let vis = set.visibility(&scene);
     let transfer = PointTransfer::new(&scene, &set, &vis);
     let (mut blended, mut corners) = (0, 0);
     for t in 0..scene.triangles.len() {

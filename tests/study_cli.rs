@@ -323,7 +323,7 @@ fn atmosphere_quick_plots_error_against_sun_elevation() {
     let e = |label: &str| setting(sw, label)["extra"]["error"].as_f64().unwrap();
     for el in ["90°", "60°", "30°", "10°", "2°"] {
         let (fog, aerial) = (
-            e(&format!("seed fog {el}")),
+            e(&format!("constant fog {el}")),
             e(&format!("Hillaire aerial {el}")),
         );
         assert!(

@@ -35,7 +35,7 @@ use std::f64::consts::PI;
 pub enum Model {
     /// No air: surfaces keep their colour, the sky is black.
     None,
-    /// The seed's constant-density model evaluated at vertices and interpolated.
+    /// The constant-density fog of Vyatkin et al. (2018) evaluated at vertices and interpolated.
     Fog,
     /// The same model evaluated per pixel.
     FogPerPixel,

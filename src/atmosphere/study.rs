@@ -187,7 +187,7 @@ pub fn lowest_within(rows: &[Row], metric: impl Fn(&Row) -> f64, limit: f64) -> 
 /// The table as Markdown.
 pub fn markdown(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| sun ° | Hillaire aerial | Hillaire march | Hillaire sky | seed fog | fog, sun attenuated | seed fog vs single | attenuated vs single | single only | fog ΔT | ref. MC rel. SE |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| sun ° | Hillaire aerial | Hillaire march | Hillaire sky | constant fog | fog, sun attenuated | constant fog vs single | attenuated vs single | single only | fog ΔT | ref. MC rel. SE |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let pc = |x: f64| {
         if x > 100.0 {

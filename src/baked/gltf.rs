@@ -23,7 +23,6 @@
 
 use crate::error::{Error, Result};
 use crate::radiosity::patches::corners::PointTransfer;
-use crate::raytrace::visibility::Visibility;
 use crate::render::direct::{gather_dense, patch_exitance};
 use crate::render::lights::{sun_light, GpuLight};
 use crate::render::mesh_reference::{shade_point, FrameSettings};
@@ -156,7 +155,7 @@ pub fn export_lit_glb(dir: &Path, setup: &LitExport, out: &Path) -> Result<LitRe
     // blending a triangle's three corners would spread one corner's light over a whole wall
     // (the Cornell box's walls are one quad each). Shading data per corner as the player draws
     // it (emitters lifted off their wall).
-    let vis = Visibility::for_patches(&scene, &set);
+    let vis = set.visibility(&scene);
     let transfer = PointTransfer::new(&scene, &set, &vis);
     let verts = rs.corner_data();
     let visible = rs.visible(&gpu_lights);

@@ -199,6 +199,20 @@ impl PatchSet {
         geometry::AreaSampler::new(polys.iter().map(|(p, n)| (p.as_slice(), *n)))
     }
 
+    /// The ray tracer over the live triangles of `scene` in this voxelization's grid frame.
+    pub fn visibility(
+        &self,
+        scene: &crate::scene::Scene,
+    ) -> crate::raytrace::visibility::Visibility {
+        let extent = self.dims.iter().copied().max().unwrap_or(1) as f64;
+        crate::raytrace::visibility::Visibility::new(
+            scene,
+            &scene.live_triangles(),
+            &self.frame(),
+            extent,
+        )
+    }
+
     /// The grid frame of this patch set.
     pub fn frame(&self) -> geometry::Frame {
         geometry::Frame {

@@ -140,12 +140,6 @@ impl Visibility {
         }
     }
 
-    /// Over the live triangles of `scene` in the grid frame of `set`, its voxelization.
-    pub fn for_patches(scene: &Scene, set: &crate::radiosity::PatchSet) -> Self {
-        let extent = set.dims.iter().copied().max().unwrap_or(1) as f64;
-        Visibility::new(scene, &scene.live_triangles(), &set.frame(), extent)
-    }
-
     /// The BVH's triangles as (scene triangle index, vertices in grid coordinates, f32): what
     /// an independent tracer needs to trace the same rays (tests/visibility_embree.rs).
     pub fn triangles(&self) -> impl Iterator<Item = (u32, [[f32; 3]; 3])> + '_ {

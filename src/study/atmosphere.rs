@@ -41,7 +41,7 @@ type Metric = fn(&Row) -> f64;
 
 /// The models plotted: (series, what it measures).
 const MODELS: [(&str, Metric); 3] = [
-    ("seed fog", |r| r.fog),
+    ("constant fog", |r| r.fog),
     ("Hillaire aerial", |r| r.hillaire_aerial),
     ("Hillaire sky", |r| r.hillaire_sky),
 ];
@@ -75,7 +75,7 @@ pub fn sweep(rows: &[Row], views: &Views) -> Sweep {
         title: "Scattered light".into(),
         description: format!(
             "In-scattered radiance of each model by sun elevation: eye at {} m, {} segments \
-             (aerial perspective, seed fog) and {} sky directions; error = the largest relative \
+             (aerial perspective, constant fog) and {} sky directions; error = the largest relative \
              error over the views and RGB",
             views.eye_altitude,
             views.segments.len(),

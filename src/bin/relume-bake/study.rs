@@ -34,7 +34,7 @@ pub enum Which {
     /// Hard shadows (exact vs accelerated), the min/max mipmap, soft shadows (every method vs exhaustive)
     #[command(after_help = STUDY_HELP)]
     Terrain(TerrainArgs),
-    /// In-scattering error of the seed fog and Hillaire's tables against sun elevation
+    /// In-scattering error of the constant-density fog and Hillaire's tables against sun elevation
     #[command(after_help = STUDY_HELP)]
     Atmosphere(AtmosphereArgs),
 }

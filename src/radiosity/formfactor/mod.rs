@@ -102,7 +102,7 @@ impl Context {
         Context {
             samplers,
             locator: PatchLocator::new(set, scene),
-            vis: Visibility::for_patches(scene, set),
+            vis: set.visibility(scene),
         }
     }
 }

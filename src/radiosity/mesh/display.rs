@@ -12,7 +12,6 @@
 
 use crate::radiosity::patches::corners::PointTransfer;
 use crate::radiosity::{PatchLists, PatchSet};
-use crate::raytrace::visibility::Visibility;
 use crate::scene::Scene;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -57,7 +56,7 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
     if split.iter().all(|&m| m == 1) {
         return (scene.clone(), set.corners.clone());
     }
-    let vis = Visibility::for_patches(scene, set);
+    let vis = set.visibility(scene);
     let transfer = PointTransfer::with_cells(scene, set, &vis, cells);
     // Per scene triangle: its sub-triangles' corner positions and lists, three per sub-triangle.
     type Part = (Vec<[f32; 3]>, Vec<Vec<(u32, f32)>>);

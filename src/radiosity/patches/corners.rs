@@ -143,7 +143,7 @@ impl Nearest {
 /// The transfer weights of any point on a scene triangle, by the rule of the corners: what the
 /// display mesh (`radiosity::mesh::display`) and the glTF export use at the vertices of a split
 /// triangle, where blending the triangle's three corners would spread one corner's light over
-/// a whole wall. `vis` is the BVH of the voxelization ([`Visibility::for_patches`]).
+/// a whole wall. `vis` is the BVH of the voxelization ([`PatchSet::visibility`](crate::radiosity::PatchSet::visibility)).
 pub struct PointTransfer<'a> {
     locator: PatchLocator,
     cells: Vec<(DVec3, f64)>,
