@@ -202,9 +202,11 @@ fuzz:
 fmt:
 	$(CARGO) fmt --all
 
+## What .ci/run checks before the tests: format, lints (with and without default features).
 lint:
 	$(CARGO) fmt --all -- --check
-	$(CARGO) clippy --release --all-targets -- -D warnings
+	$(CARGO) clippy --locked --all-targets -- -D warnings
+	$(CARGO) clippy --locked --lib --no-default-features -- -D warnings
 
 bench: build
 	$(CARGO) bench --locked

@@ -12,11 +12,13 @@ pub mod compress;
 pub mod cpu;
 pub mod error;
 pub mod freeform;
+#[cfg(feature = "player")]
 pub mod gpu;
 pub mod heightmap;
 pub mod limits;
 pub mod load;
 pub mod pipeline;
+#[cfg(feature = "player")]
 pub mod player;
 pub mod progress;
 pub mod radiosity;

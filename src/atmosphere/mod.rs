@@ -30,7 +30,8 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// Which scattered-light model a renderer applies (the player's choice).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Model {
     /// No air: surfaces keep their colour, the sky is black.

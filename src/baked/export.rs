@@ -6,7 +6,8 @@ use serde::Serialize;
 use std::path::Path;
 
 /// What `relume-bake export` writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum ExportWhat {
     /// The patches as JSON.
     Patches,
@@ -22,7 +23,8 @@ pub enum ExportWhat {
 }
 
 /// A standard light configuration of the encode report (`compress::report::standard_lights`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum StandardLight {
     Uniform,
     Random,

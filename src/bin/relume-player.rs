@@ -5,11 +5,12 @@ use clap::Parser;
 use relume::error::{exit, Result};
 use relume::gpu::compressed_gather::DecodePath;
 use relume::gpu::{BackendChoice, Gpu};
-use relume::player::headless::{args, render_frames, HeadlessPlan};
-use relume::player::light_spec::parse_light;
+use relume::pipeline::checks::arg as args;
+use relume::player::headless::{render_frames, HeadlessPlan};
 use relume::player::{PlayerOptions, Sun, TransportChoice};
 use relume::render::camera::Camera;
 use relume::render::mesh_reference::FrameSettings;
+use relume::scene::light_spec::parse_light;
 use relume::scene::Light;
 use std::path::PathBuf;
 
@@ -41,7 +42,7 @@ struct Cli {
     #[arg(long, value_name = "DIR", default_value = "out/frames")]
     out: PathBuf,
     /// Image size
-    #[arg(long, value_name = "WxH", default_value = "640x480", value_parser = args::size)]
+    #[arg(long, value_name = "WxH", default_value = "640x480", value_parser = args::frame_size)]
     size: (u32, u32),
     /// Sun azimuth (degrees clockwise from north) and elevation (degrees), e.g. 135,30
     #[arg(long, value_name = "AZ,EL", value_parser = args::sun, allow_hyphen_values = true)]

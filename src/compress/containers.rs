@@ -21,7 +21,8 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// A texture container the `encode` stage writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Container {
     Dds,
     Ktx2,

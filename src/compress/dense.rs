@@ -19,7 +19,8 @@ use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// How the dense part is stored.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum DenseEncoding {
     /// The radiosity thesis's: 8-bit log codes of the three channels as one BC1 texel (0.5 byte/entry).
     Bc1Log,

@@ -20,9 +20,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// What the greedy pass compares.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum ReorderMetric {
     /// The radiosity thesis's: sum of absolute differences of the raw values.
     #[default]
@@ -33,9 +32,8 @@ pub enum ReorderMetric {
 }
 
 /// How a greedy pass finds each next row: both give the thesis's greedy order.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum ReorderMethod {
     /// The thesis's: all n²/2 pairwise distances (O(channels·n³), an n×n matrix and copies of S).
     Full,

@@ -20,7 +20,8 @@ use super::field::{dot, Bump, Field, Op, Quad};
 use serde::{Deserialize, Serialize};
 
 /// Which bound culls cells.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Bound {
     /// Interval arithmetic over the cell's bounding box.
     Interval,

@@ -11,7 +11,8 @@ use crate::error::{Error, Result};
 use wgpu::util::DeviceExt;
 
 /// How the dense part is decoded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum DecodePath {
     /// The texture unit decodes BC blocks (needs `TEXTURE_COMPRESSION_BC`; BC1 and BC6H).
     Hardware,

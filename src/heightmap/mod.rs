@@ -34,7 +34,8 @@ pub struct HeightMap {
 }
 
 /// What to do with no-data texels (NaN, infinities, or the no-data value).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum NoDataPolicy {
     /// Refuse the height map, naming the first no-data texel (the default).
     #[default]

@@ -189,6 +189,70 @@ pub mod arg {
         }
         Ok((w, h))
     }
+
+    use crate::render::camera::Camera;
+    use crate::terrain::Sun;
+
+    /// `WIDTHxHEIGHT`, each in 1..=16384.
+    pub fn frame_size(s: &str) -> Result<(u32, u32), String> {
+        let (w, h) = wxh(s)?;
+        if w > 16384 || h > 16384 {
+            return Err("width and height must be in 1..=16384".into());
+        }
+        Ok((w as u32, h as u32))
+    }
+
+    fn floats(s: &str) -> Result<Vec<f32>, String> {
+        s.split(',')
+            .map(|t| {
+                t.trim()
+                    .parse::<f32>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| format!("`{t}` is not a finite number"))
+            })
+            .collect()
+    }
+
+    /// `AZIMUTH,ELEVATION` in degrees, elevation in [−90, 90].
+    pub fn sun(s: &str) -> Result<Sun, String> {
+        match floats(s)?.as_slice() {
+            [az, el] if (-90.0..=90.0).contains(el) => Ok(Sun {
+                azimuth_deg: *az as f64,
+                elevation_deg: *el as f64,
+            }),
+            [_, el] => Err(format!("elevation {el} is outside -90..=90 degrees")),
+            _ => Err(format!("`{s}` is not AZIMUTH,ELEVATION (e.g. 135,30)")),
+        }
+    }
+
+    /// `EX,EY,EZ,TX,TY,TZ[,FOV]`: eye, target and the vertical field of view in degrees.
+    pub fn camera(s: &str) -> Result<Camera, String> {
+        let v = floats(s)?;
+        if v.len() != 6 && v.len() != 7 {
+            return Err(format!(
+                "`{s}` needs 6 or 7 numbers: eye x,y,z, target x,y,z[, fov]"
+            ));
+        }
+        let eye = glam::Vec3::new(v[0], v[1], v[2]);
+        let target = glam::Vec3::new(v[3], v[4], v[5]);
+        let d = (target - eye).length();
+        if d <= 0.0 {
+            return Err("eye and target must differ".into());
+        }
+        let fov = v.get(6).copied().unwrap_or(39.3077);
+        if !(1.0..=170.0).contains(&fov) {
+            return Err(format!("field of view {fov} is outside 1..=170 degrees"));
+        }
+        Ok(Camera {
+            eye,
+            target,
+            up: glam::Vec3::Y,
+            fov_y_deg: fov,
+            near: d * 1e-3,
+            far: d * 100.0,
+        })
+    }
 }
 
 /// serde adaptors (`deserialize_with`) over the same checks.

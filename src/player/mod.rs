@@ -3,7 +3,6 @@
 
 mod freeform;
 pub mod headless;
-pub mod light_spec;
 mod mesh;
 mod terrain;
 pub mod window;
@@ -26,7 +25,8 @@ use std::path::Path;
 pub use crate::terrain::sun::Sun;
 
 /// Which transport the runtime gathers from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum TransportChoice {
     /// The encoded transport when the bake has one, else the dense matrix.
     #[default]

@@ -10,6 +10,7 @@ pub mod builder;
 pub mod freeform;
 pub mod generate;
 mod gltf_loader;
+pub mod light_spec;
 mod obj_loader;
 pub mod obj_writer;
 pub mod punctual;

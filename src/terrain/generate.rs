@@ -7,7 +7,8 @@ use crate::heightmap::HeightMap;
 use serde::{Deserialize, Serialize};
 
 /// Which map to generate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Shape {
     /// Five thin cones (base radius N/64, heights N/8..N/4) on flat ground.

@@ -30,7 +30,8 @@ use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
 /// Which form-factor estimator to use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Estimator {
     /// N cosine-distributed rays from each patch (N = samples).
     Hemisphere,

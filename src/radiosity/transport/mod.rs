@@ -49,7 +49,8 @@ pub enum Bounces {
 }
 
 /// How `S_k` is evaluated for finite k.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Power {
     /// Whichever of Horner and doubling needs fewer matrix products.
     #[default]

@@ -17,7 +17,8 @@ use rooms::{Doorway, Room, RoomRow, ShellMaterials};
 use serde::{Deserialize, Serialize};
 
 /// The scenes `generate` makes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Generated {
     /// A living room (table, chairs, sofa, bookshelf, picture, a vase and a statue of
