@@ -89,12 +89,6 @@ pub struct StageTiming {
     pub report: std::collections::BTreeMap<String, f64>,
 }
 
-/// Bake `pipeline` into `output`. On any error nothing is written and a previous bake at
-/// `output` is left as it was.
-///
-/// Before each stage that runs (is not taken from the cache), the rest of the pipeline is
-/// planned again with the sizes measured so far (the real patch count after voxelize) and the
-/// plan's peak is checked against `opts.max_memory`.
 /// Read and check the files stages name (a `Themes` stage's theme set) before any work, so a
 /// missing or malformed one stops the bake before the input is loaded.
 fn check_stage_files(pipeline: &Pipeline) -> Result<()> {
@@ -132,6 +126,15 @@ fn check_stage_input(pipeline: &Pipeline, input: &LoadedInput) -> Result<()> {
     Ok(())
 }
 
+/// Bake `pipeline` into `output`. On any error nothing is written and a previous bake at
+/// `output` is left as it was.
+///
+/// Before each stage that runs (is not taken from the cache), the rest of the pipeline is
+/// planned again with the sizes measured so far (the real patch count after voxelize) and the
+/// plan's peak is checked against `opts.max_memory`.
+///
+/// This is the library's entry point for a bake: `relume-bake run` is this function with
+/// progress bars. `examples/bake_scene.rs` shows it end to end.
 pub fn run_pipeline(
     pipeline: &Pipeline,
     output: &Path,

@@ -50,7 +50,7 @@ pub fn write_f32_channels(
 
 /// Read the first layer's channels as f32: (width, height, [(name, values)]), channels sorted by name.
 pub fn read_f32_channels(path: &Path) -> Result<(usize, usize, Channels)> {
-    use exr::prelude::{read, FlatSamples, ReadChannels, ReadLayers};
+    use exr::prelude::FlatSamples;
     let parts = crate::limits::check_exr_header(path)?;
     if parts > 1 {
         return Err(Error::input(
@@ -58,21 +58,8 @@ pub fn read_f32_channels(path: &Path) -> Result<(usize, usize, Channels)> {
             format!("a multi-part EXR ({parts} parts) where relume writes a single part"),
         ));
     }
-    let reader = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes();
-    // exr 1.74's B44 decoder relies on wrapping u32 arithmetic (as OpenEXR's C code does with
-    // unsigned ints): release builds wrap and decode in parallel; with overflow checks (debug
-    // builds, and the fuzzers' builds) it panics — in a worker thread, where the panic aborts the
-    // process (found by AFL). So debug builds decode on this thread, and the decode is contained
-    // either way: a panic is an input error naming the file.
-    #[cfg(debug_assertions)]
-    let reader = reader.non_parallel();
-    let image = crate::error::contain_panic(path, "EXR decoder", || reader.from_file(path))?
-        .map_err(|e| exr_error(path, "cannot read EXR", e))?;
+    let image =
+        crate::heightmap::decode_exr(path)?.map_err(|e| exr_error(path, "cannot read EXR", e))?;
     let layer = image.layer_data;
     let channels = layer
         .channel_data

@@ -13,6 +13,7 @@
 pub mod georef;
 pub mod minmax_mipmap;
 mod readers;
+pub use readers::{decode_exr, ExrImage};
 pub mod utm;
 
 use crate::error::{Error, Result};

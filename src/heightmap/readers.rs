@@ -259,8 +259,35 @@ fn equal_channels<T: Copy + PartialEq + Into<f64>>(
     Ok(out)
 }
 
+/// An EXR's first valid layer at its largest resolution, every channel as flat samples: the
+/// one decode of relume's EXR readers (height maps here, the bake's own files in
+/// `crate::baked::exr_io`). The caller checks the part count first
+/// (`crate::limits::check_exr_header`) and maps the decoder's errors its own way.
+///
+/// exr 1.74's B44 decoder relies on wrapping u32 arithmetic (as OpenEXR's C code does with
+/// unsigned ints): release builds wrap and decode in parallel; with overflow checks (debug
+/// builds, and the fuzzers' builds) it panics — in a worker thread, where the panic aborts the
+/// process (found by AFL). So debug builds decode on this thread, and the decode is contained
+/// either way: a panic is an input error naming the file.
+pub fn decode_exr(path: &Path) -> Result<std::result::Result<ExrImage, exr::error::Error>> {
+    use exr::prelude::{read, ReadChannels, ReadLayers};
+    let reader = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes();
+    #[cfg(debug_assertions)]
+    let reader = reader.non_parallel();
+    crate::error::contain_panic(path, "EXR decoder", || reader.from_file(path))
+}
+
+/// What [`decode_exr`] returns: one layer, any channels, flat samples.
+pub type ExrImage =
+    exr::image::Image<exr::image::Layer<exr::image::AnyChannels<exr::image::FlatSamples>>>;
+
 fn read_exr(path: &Path) -> Result<RawGrid> {
-    use exr::prelude::{read, FlatSamples, ReadChannels, ReadLayers};
+    use exr::prelude::FlatSamples;
     let parts = crate::limits::check_exr_header(path)?;
     if parts > 1 {
         // A multi-part file (e.g. a bake's minmax_mipmap.exr) is not one height field; reading
@@ -270,20 +297,10 @@ fn read_exr(path: &Path) -> Result<RawGrid> {
             format!("a multi-part EXR ({parts} parts): a height map is a single-part file"),
         ));
     }
-    let reader = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes();
-    // Debug builds decode on this thread, contained (crate::baked::exr_io::read_f32_channels).
-    #[cfg(debug_assertions)]
-    let reader = reader.non_parallel();
-    let image = crate::error::contain_panic(path, "EXR decoder", || reader.from_file(path))?
-        .map_err(|e| match e {
-            exr::error::Error::Io(io) => Error::io(path, "cannot read height map", io),
-            other => Error::input(path, format!("cannot decode EXR: {other}")),
-        })?;
+    let image = decode_exr(path)?.map_err(|e| match e {
+        exr::error::Error::Io(io) => Error::io(path, "cannot read height map", io),
+        other => Error::input(path, format!("cannot decode EXR: {other}")),
+    })?;
     let layer = &image.layer_data;
     let channels = &layer.channel_data.list;
     let pick = if channels.len() == 1 {

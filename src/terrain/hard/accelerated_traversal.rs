@@ -78,6 +78,42 @@ pub fn coordinate_after(
     }
     c
 }
+/// The texel the track enters after leaving block (bx, by) of 2^`shift` texels at
+/// `t_exit = min(txb, tyb)` ([`block_exit_time`] per axis): one step past the block's last
+/// texel on the axis whose boundary the track crosses first (both at a corner), and on the other
+/// axis the coordinate the track has at `t_exit` ([`coordinate_after`], from the current texel
+/// `i`). Shared by the accelerated hard-shadow walk and the soft-shadow branch and bound.
+#[inline]
+pub fn texel_after_block(
+    track: &Track,
+    p: [f64; 2],
+    i: [i64; 2],
+    b: [i64; 2],
+    shift: i64,
+    [txb, tyb]: [f64; 2],
+) -> [i64; 2] {
+    let (sx, sy) = (track.step_x, track.step_y);
+    let t_exit = txb.min(tyb);
+    let last = |b: i64, s: i64| {
+        if s > 0 {
+            ((b + 1) << shift) - 1
+        } else {
+            b << shift
+        }
+    };
+    let (last_x, last_y) = (last(b[0], sx), last(b[1], sy));
+    let nx = if txb <= tyb {
+        last_x + sx
+    } else {
+        coordinate_after(p[0], track.ux, sx, track.inv_ux, t_exit, i[0], last_x)
+    };
+    let ny = if tyb <= txb {
+        last_y + sy
+    } else {
+        coordinate_after(p[1], track.uy, sy, track.inv_uy, t_exit, i[1], last_y)
+    };
+    [nx, ny]
+}
 
 /// Is the pixel at (col, row) in shadow? Accelerated traversal A2 over `mip` (built from
 /// `map`). Equal to `shadowed_exact(map, track, col, row, _)` for every pixel.
@@ -139,28 +175,7 @@ pub fn shadowed_accelerated(
         let t_exit = txb.min(tyb);
         if bmax as f64 - zp <= rise * t_in {
             // Max test passed: skip the block.
-            let last_x = if sx > 0 {
-                ((bx + 1) << shift) - 1
-            } else {
-                bx << shift
-            };
-            let last_y = if sy > 0 {
-                ((by + 1) << shift) - 1
-            } else {
-                by << shift
-            };
-            let nx = if txb <= tyb {
-                last_x + sx
-            } else {
-                coordinate_after(px, track.ux, sx, track.inv_ux, t_exit, ix, last_x)
-            };
-            let ny = if tyb <= txb {
-                last_y + sy
-            } else {
-                coordinate_after(py, track.uy, sy, track.inv_uy, t_exit, iy, last_y)
-            };
-            ix = nx;
-            iy = ny;
+            [ix, iy] = texel_after_block(track, [px, py], [ix, iy], [bx, by], shift, [txb, tyb]);
             t_in = t_exit;
             if ix < 0 || iy < 0 || ix >= w || iy >= h || rise * t_in >= headroom {
                 return false;

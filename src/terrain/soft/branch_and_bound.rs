@@ -12,7 +12,7 @@
 //! 1e-9 in lit fraction). No recursion, no allocation; the loop is bounded like A2's.
 
 use crate::heightmap::HeightMap;
-use crate::terrain::hard::accelerated_traversal::{block_exit_time, coordinate_after};
+use crate::terrain::hard::accelerated_traversal::{block_exit_time, texel_after_block};
 use crate::terrain::hard::exact_traversal::texel_sample;
 use crate::terrain::minmax_mipmap::MinMaxMipmap;
 use crate::terrain::soft::model::{beyond_reach, slope, slope_upper_bound, PixelSun};
@@ -81,28 +81,7 @@ pub fn lit_branch_and_bound(
                 level -= 1;
                 continue;
             }
-            let last_x = if sx > 0 {
-                ((bx + 1) << shift) - 1
-            } else {
-                bx << shift
-            };
-            let last_y = if sy > 0 {
-                ((by + 1) << shift) - 1
-            } else {
-                by << shift
-            };
-            let nx = if txb <= tyb {
-                last_x + sx
-            } else {
-                coordinate_after(px, track.ux, sx, track.inv_ux, t_exit, ix, last_x)
-            };
-            let ny = if tyb <= txb {
-                last_y + sy
-            } else {
-                coordinate_after(py, track.uy, sy, track.inv_uy, t_exit, iy, last_y)
-            };
-            ix = nx;
-            iy = ny;
+            [ix, iy] = texel_after_block(track, [px, py], [ix, iy], [bx, by], shift, [txb, tyb]);
             t_in = t_exit;
             if level < top {
                 level += 1;
