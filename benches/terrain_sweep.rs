@@ -3,7 +3,7 @@
 //! floor, best of 5), of the sweep mask (best of 3, mipmap built beforehand and reported on its
 //! own), and of the accelerated traversal (A2); the sweep/floor ratio; how the sweep decided
 //! its pixels; and the pixels where the sweep differs from A2 (which equals the exact traversal
-//! on every pixel, tests/terrain_exactness.rs) and, at 1K, from the exact traversal itself.
+//! on every pixel, tests/terrain/exactness.rs) and, at 1K, from the exact traversal itself.
 //!
 //! `cargo bench --bench terrain_sweep` (env: RELUME_BENCH_SIZES, e.g. "1024,4096";
 //! RELUME_BENCH_AZIMUTH, default 300; RELUME_BENCH_ELEVATIONS, default "2,5,10,30,60";

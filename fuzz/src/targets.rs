@@ -6,7 +6,7 @@
 //! run explores all of them. Inputs that need a file are written to a per-process scratch
 //! directory (`/dev/shm` when it exists), because the readers take paths, like the CLI.
 //!
-//! This file depends only on `relume` and `std`: `tests/fuzz_corpus.rs` includes it to replay
+//! This file depends only on `relume` and `std`: `tests/cli/fuzz_corpus.rs` includes it to replay
 //! every corpus and crash input as a regression test.
 
 use std::path::{Path, PathBuf};

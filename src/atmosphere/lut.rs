@@ -9,7 +9,7 @@
 //!   the horizon (grazing paths through the low Mie layer): L₂ came out 22 % low in red at 1.5 km
 //!   against a 32,768-direction quadrature. Here 4 azimuths × 16 zenith bands, split at the
 //!   horizon and crowded toward it, with steps crowded toward the point ([`band`]): within 2 %
-//!   of that quadrature from 0.1 to 20 km, at the same cost (`tests/atmosphere_orders.rs`).
+//!   of that quadrature from 0.1 to 20 km, at the same cost (`tests/library/atmosphere_orders.rs`).
 //! - **Sky view** L(θ, φ) at the eye: 30 steps (quadratic spacing) to the ground or the top;
 //!   single scattering (phase, T from the table, planet shadow) plus σ_s·Ψ_ms.
 //! - **Aerial perspective** (φ, θ, s): the same integrand over 20 uniform steps from the eye to

@@ -8,7 +8,7 @@
 //! boundary (where the sun ray grazes the ground) and the ozone tent's kinks are panel ends, so
 //! every panel's integrand is smooth. With 8 nodes per panel the single scattering of every ray
 //! the tests use agrees with a 20,000-step Simpson rule to better than 1e-6 relative (see
-//! `tests/atmosphere.rs`).
+//! `tests/library/atmosphere.rs`).
 
 use super::{blocked_by_ground, ray_exit, ray_sphere, Atmosphere};
 use glam::DVec3;

@@ -15,7 +15,7 @@
 //! and the mesher picks the least `k` whose sum of both terms is within the tolerance. The
 //! two polar caps (half a row beyond the first and last sample rows, where the height is
 //! clamped to the row's: no twist) get k rows of quads down to the row's heights on the polar
-//! axis, chords as small as the cells'; `tests/freeform_mesh.rs` measures the Hausdorff
+//! axis, chords as small as the cells'; `tests/library/freeform_mesh.rs` measures the Hausdorff
 //! distance of both carriers.
 //!
 //! Preconditions: a compiled texture ([`Texture`]); a plane carrier is meshed over its grid's

@@ -17,7 +17,7 @@
 //!   Chebyshev error δ is recomputed from the f32 line itself at the three points where a
 //!   convex function's deviation from a line can peak.
 //!
-//! `tests/freeform_twin.rs` checks containment on random cells (proptest) and that the GPU
+//! `tests/gpu/freeform_twin.rs` checks containment on random cells (proptest) and that the GPU
 //! (lavapipe) returns the twin's hit mask, depths and normals.
 
 use super::field::{Field, Op, Quad};

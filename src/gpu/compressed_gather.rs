@@ -33,7 +33,7 @@ impl DecodePath {
 }
 
 /// The `GatherParams` uniform of `gather_compressed.wgsl` (public for the layout test in
-/// tests/gpu_layout.rs).
+/// tests/gpu/layout.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Params {

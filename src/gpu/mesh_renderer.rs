@@ -23,7 +23,7 @@ pub struct LightsUniform {
     pub layer_view_proj: [[f32; 16]; MAX_SHADOW_LAYERS],
 }
 
-/// The `Frame` uniform of `mesh_shade.wgsl` (public for the layout test in tests/gpu_layout.rs).
+/// The `Frame` uniform of `mesh_shade.wgsl` (public for the layout test in tests/gpu/layout.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FrameUniform {

@@ -18,7 +18,7 @@ use crate::terrain::MinMaxMipmap;
 use glam::{Mat4, Vec3};
 
 /// The `TerrainParams` uniform of `terrain_shadow.wgsl` (public for the layout test in
-/// tests/gpu_layout.rs).
+/// tests/gpu/layout.rs).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TerrainParams {
@@ -52,7 +52,7 @@ pub struct TerrainParams {
 }
 
 /// The `TerrainFrame` uniform of `terrain_render.wgsl` (public for the layout test in
-/// tests/gpu_layout.rs).
+/// tests/gpu/layout.rs).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TerrainFrame {

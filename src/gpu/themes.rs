@@ -2,7 +2,7 @@
 //! Colour Cell Compressed, exception blocks, theme texels, turbulence map, sRGB table, classes,
 //! level table) and the `ThemeParams` uniform of `shaders/theme.wgsl`, bound as group 2 by the
 //! terrain frame; and the test kernel (`theme_kernel.wgsl`) that evaluates the albedo at given
-//! points, compared with `theme::compose` in tests/gpu_themes.rs.
+//! points, compared with `theme::compose` in tests/gpu/themes.rs.
 
 use super::{compute, readback, Gpu};
 use crate::error::Result;

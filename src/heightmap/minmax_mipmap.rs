@@ -15,7 +15,7 @@
 //! result to the range of the four texels of Q's bilinear cell; for Q in T's square those four
 //! texels lie within one texel of T (border-clamped), hence inside the block's bordered
 //! footprint. So every sample h satisfies min ≤ h ≤ max, exactly, in floating point (no
-//! rounding is involved in a min/max of f32 values); `tests/terrain_exactness.rs` checks it with
+//! rounding is involved in a min/max of f32 values); `tests/terrain/exactness.rs` checks it with
 //! proptest. The bound is looser than the exact range of bilinear values (which would need
 //! averages and outward rounding to stay provable) only next to a block's border.
 //!

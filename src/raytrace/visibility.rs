@@ -141,7 +141,7 @@ impl Visibility {
     }
 
     /// The BVH's triangles as (scene triangle index, vertices in grid coordinates, f32): what
-    /// an independent tracer needs to trace the same rays (tests/visibility_embree.rs).
+    /// an independent tracer needs to trace the same rays (tests/radiosity/visibility_embree.rs).
     pub fn triangles(&self) -> impl Iterator<Item = (u32, [[f32; 3]; 3])> + '_ {
         self.ids
             .iter()
@@ -204,7 +204,7 @@ impl Visibility {
     }
 
     /// [`Visibility::closest_hit`] by testing every triangle slot in order with the scalar test:
-    /// the same answer bit for bit (tests/radiosity_visibility.rs), without the tree.
+    /// the same answer bit for bit (tests/radiosity/visibility.rs), without the tree.
     pub fn closest_hit_brute_force(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
         self.trace_closest_brute_force(&Ray::new(origin, dir))
     }

@@ -24,7 +24,7 @@ open("colour.png", "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack
                                + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 # A raw f32 file of 3 values (not a whole 2x2 grid).
 open("short.raw", "wb").write(struct.pack("<3f", 1, 2, 3))
-# Added with the discovered corpus (tests/bad_inputs.rs):
+# Added with the discovered corpus (tests/cli/bad_inputs.rs):
 # A .npy of the wrong shape and one of float64, for tampered bakes given to the player.
 np.save("wrong-shape.npy", np.zeros((3, 5), dtype=np.float32))
 np.save("float64.npy", np.zeros((3, 4, 4), dtype=np.float64))

@@ -1,5 +1,5 @@
 //! The rays of the form-factor stage (hemisphere rays, pairwise segments), with the BVH's
-//! triangles, written as `.npy` for Embree (`embreex`): shared by `tests/visibility_embree.rs`
+//! triangles, written as `.npy` for Embree (`embreex`): shared by `tests/radiosity/visibility_embree.rs`
 //! (agreement) and `benches/visibility_embree.rs` (speed).
 
 use glam::DVec3;
@@ -59,7 +59,7 @@ pub fn write_for_embree(
 ) -> (Vec<u32>, Vec<[[f32; 3]; 3]>) {
     let triangles = write_triangles(dir, ctx);
     // Embree gets each ray from its origin in f32 (relume rounds its backed-off start to f32
-    // separately: see tests/visibility_embree.rs for what that allows).
+    // separately: see tests/radiosity/visibility_embree.rs for what that allows).
     let f32_rays = f32_rays(rays);
     let o: Vec<f32> = f32_rays.iter().flat_map(|r| r.0).collect();
     let d: Vec<f32> = f32_rays.iter().flat_map(|r| r.1).collect();

@@ -1,6 +1,6 @@
 //! Bake a bundled room scene in memory at a patch target (voxelize → reciprocal hemisphere form
 //! factors, 4096 rays → infinite bounces) and return its per-object light; shared by
-//! `tests/radiosity_rooms.rs` and `benches/rooms_mitsuba.rs`.
+//! `tests/radiosity/rooms.rs` and `benches/rooms_mitsuba.rs`.
 #![allow(dead_code)]
 
 use relume::progress::Silent;

@@ -7,7 +7,7 @@
 //!
 //! To use the real Cornell box instead, set `RELUME_TRANSPORT_NPY=path/to/transport.npy`:
 //! [`transport_or_env`] then reads it with `relume::baked::read_npy_f32`.
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use relume::radiosity::TransportMatrix;
 

@@ -2,7 +2,7 @@
 //! exitance, two ways — through the per-corner interpolation on the display mesh (what the
 //! player shows, `radiosity::mesh::display`) and straight from the patches each triangle's visible
 //! area went into (the radiosity solution itself). This is the quantity a path tracer's irradiance meter measures
-//! on the same object, so it is how bakes are compared with Mitsuba (`tests/radiosity_rooms.rs`)
+//! on the same object, so it is how bakes are compared with Mitsuba (`tests/radiosity/rooms.rs`)
 //! and how the study reports per-object error.
 //!
 //! The radiosity solution's irradiance at patch p is H_p = B_p / ρ_p (B the reflected exitance,

@@ -11,7 +11,7 @@
 //! 2n³/3, 2n³ in all, the flops of one GEMM, as for the full inverse.
 //!
 //! A panel's columns depend only on (M, the panel's index): the LU is deterministic (faer splits
-//! work the same way for any thread count; `tests/determinism.rs`), the panel width depends only
+//! work the same way for any thread count; `tests/cli/determinism.rs`), the panel width depends only
 //! on n, and each panel is solved by its own calls.
 //!
 //! Off the diagonal `S = A⁻¹`. On it, `A⁻¹ − I` would keep only the absolute precision of the

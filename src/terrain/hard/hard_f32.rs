@@ -5,7 +5,7 @@
 //! agree on every pixel) — and measure how far f32 moves from the f64 reference: only pixels
 //! whose deciding sample is within f32 rounding of the sun ray flip. f32 positions near x ≈ 1000
 //! carry ~6e-5 texel of error, millimetres of height on steep slopes: measured 3 pixels in
-//! 10,000 on the half-size SRTM map and fewer on Puget Sound (`tests/terrain_f32.rs`). A WGSL
+//! 10,000 on the half-size SRTM map and fewer on Puget Sound (`tests/terrain/f32.rs`). A WGSL
 //! port should match these twins up to its own rounding of division and conversions.
 //!
 //! Inputs: the f64 [`Track`] rounded to f32 ([`TrackF32`]), the same flat arrays.

@@ -31,7 +31,7 @@
 //! over f, the tangent shifted by 2κτ_P. [`horizon_exact_curved`] is the reference on the
 //! sphere itself (the soft-shadow model's geometry, where distances and drops scale by
 //! (R + h)/R); the parabola — the usual GIS model, as in GRASS r.horizon — differs from it by a
-//! relative h/R of the slope: 0.0092° at worst on Big Tujunga on Earth (tests/terrain_horizon.rs).
+//! relative h/R of the slope: 0.0092° at worst on Big Tujunga on Earth (tests/terrain/horizon.rs).
 //!
 //! The azimuths are close to, not exactly, uniform: within 0.3 of the spacing (the actual ones
 //! are stored with the map, and the sky-view factor weights each by its gaps). The samples are bit for bit the walk's up to the rounding

@@ -10,7 +10,7 @@
 //! itself (2 ulp of π/2: 5·10⁻³ of a step), and the old path's f32 conversion to degrees
 //! cost as much (1.4·10⁻³ of a step). So a value can differ from `encode`'s by one step only
 //! within 0.01 of a step from a midpoint; the unit test bounds every value's distance from
-//! the exact step of the f32 slope, and `tests/terrain_horizon.rs` the map's from the exact
+//! the exact step of the f32 slope, and `tests/terrain/horizon.rs` the map's from the exact
 //! horizon. It saves the two f64 divisions and conversions of `encode` per lane.
 
 #[cfg(target_arch = "x86_64")]

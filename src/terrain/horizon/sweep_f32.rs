@@ -4,7 +4,7 @@
 //! [`crate::terrain::horizon::lanes`]), and the angles quantised to the horizon map's u16 on the way out
 //! ([`crate::terrain::horizon::quantise`]). The f64 sweep is the exact reference (bit for bit the per-pixel
 //! walk up to rounding); this one is what [`crate::terrain::horizon::map::HorizonMap::build`] runs. Its error
-//! against the exact horizon is measured in `tests/terrain_horizon.rs` and docs/terrain.md: f32
+//! against the exact horizon is measured in `tests/terrain/horizon.rs` and docs/terrain.md: f32
 //! rounding of the samples and of the slopes, 3e-5° on Puget Sound 4096² (the u16 step is 0.0027°),
 //! up to 2e-3° next to a synthetic 178 m cliff between half-metre texels.
 //!

@@ -1,0 +1,24 @@
+//! Integration tests: GPU kernels against their CPU twins (Mesa lavapipe in CI), uniform layouts,
+//! headless player frames.
+//!
+//! One test binary per concept (each links the whole library once); one module per file.
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../support/gpu_twins.rs"]
+mod twins;
+
+mod atmosphere;
+mod freeform_gpu_shade;
+mod freeform_gpu_texture;
+mod freeform_twin;
+mod gather;
+mod kernels;
+mod layout;
+mod player;
+mod terrain;
+mod terrain_air;
+mod themes;
+mod twins_direct;
+mod twins_lighting;
+mod twins_raster;

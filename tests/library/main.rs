@@ -1,0 +1,24 @@
+//! Integration tests: the library's algorithms against independent references, and the layout of
+//! the source tree.
+//!
+//! One test binary per concept (each links the whole library once); one module per file.
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../support/transport_box.rs"]
+mod transport_box;
+
+mod architecture;
+mod atmosphere;
+mod atmosphere_orders;
+mod compress_lib;
+mod freeform_mesh;
+mod freeform_mesh_texture;
+mod freeform_quadrics;
+mod freeform_rmlrc;
+mod freeform_texture;
+mod independent_decoders;
+mod loaders;
+mod reorder_bounded;
+mod themes;
+mod themes_geo;

@@ -1,0 +1,19 @@
+//! Integration tests: the radiosity bake: patches, form factors, visibility (against Embree),
+//! transport, export.
+//!
+//! One test binary per concept (each links the whole library once); one module per file.
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../support/room_light.rs"]
+mod room_light;
+
+mod adaptive;
+mod export_gltf;
+mod formfactors;
+mod locate;
+mod rooms;
+mod transport;
+mod visibility;
+mod visibility_embree;
+mod voxelize;
