@@ -5,7 +5,8 @@
 //! Run: `cargo bench --bench formfactor_accuracy` (add `-- --quick` for fewer seeds).
 
 use relume::progress::Silent;
-use relume::radiosity::fixtures;
+#[path = "../tests/support/fixtures.rs"]
+mod fixtures;
 use relume::radiosity::formfactor::{analytic, form_factors, Estimator, FormFactorParams};
 use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::scene::Scene;

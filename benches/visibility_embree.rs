@@ -23,6 +23,8 @@
 
 #[path = "../tests/support/embree_rays.rs"]
 mod embree_rays;
+#[path = "../tests/support/fixtures.rs"]
+mod fixtures;
 
 use embree_rays::{
     f32_rays, f32_segments, hemisphere_rays, pairwise_segments, write_for_embree, write_segments,
@@ -92,11 +94,7 @@ fn main() {
     .unwrap();
     let scenes = [
         ("Cornell box", cornell, 1024u32),
-        (
-            "soup 10k",
-            relume::radiosity::fixtures::random_soup(10_000, 5),
-            4000,
-        ),
+        ("soup 10k", fixtures::random_soup(10_000, 5), 4000),
         (
             "furnished room",
             relume::scene::load_scene(

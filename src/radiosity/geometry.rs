@@ -197,16 +197,8 @@ pub fn point_in_triangle(a: DVec3, b: DVec3, c: DVec3, u: f64, v: f64) -> DVec3 
     a * (1.0 - su) + b * (su * (1.0 - v)) + c * (su * v)
 }
 
-/// An orthonormal basis (t, b) around the unit vector `n` (Duff et al. 2017, branchless).
-pub fn basis(n: DVec3) -> (DVec3, DVec3) {
-    let sign = 1f64.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    (
-        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        DVec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
-}
+/// An orthonormal basis (t, b) around a unit vector (the scene builder's discs use it too).
+pub use crate::scene::builder::basis;
 
 /// A cosine-distributed direction about the unit normal `n` from `u, v` in [0, 1).
 pub fn cosine_direction(n: DVec3, u: f64, v: f64) -> DVec3 {

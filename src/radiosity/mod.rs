@@ -14,7 +14,6 @@
 //! docs/baked-format.md describes
 //! them byte by byte.
 
-pub mod fixtures;
 pub mod formfactor;
 pub mod geometry;
 pub mod mesh;

@@ -1,6 +1,6 @@
 //! Building a [`Scene`] in code: polygons, grids of quads with holes, closed boxes and surfaces
 //! of revolution. Used by the bundled scene generators (`scene::generate`) and by the synthetic
-//! scenes of tests and benchmarks (`radiosity::fixtures`).
+//! scenes of tests and benchmarks (`tests/support/fixtures.rs`).
 //!
 //! Every face winds counter-clockwise about its front normal (the scene convention). Coordinates
 //! are given in f64 and stored as f32; two faces built from the same f64 corners therefore share
@@ -21,6 +21,27 @@ pub struct SceneBuilder {
 }
 
 impl SceneBuilder {
+    /// A regular `segments`-gon of circumradius `r` at `centre` facing `normal`.
+    pub fn disc(
+        &mut self,
+        object: &str,
+        centre: DVec3,
+        normal: DVec3,
+        r: f64,
+        segments: usize,
+        material: u32,
+    ) {
+        let n = normal.normalize();
+        let (t, b) = basis(n);
+        let pts: Vec<DVec3> = (0..segments)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / segments as f64;
+                centre + r * (t * a.cos() + b * a.sin())
+            })
+            .collect();
+        self.polygon(object, &pts, material);
+    }
+
     /// Every triangle gets its own three vertices.
     pub fn new() -> Self {
         Self::default()
@@ -259,6 +280,17 @@ pub enum Face {
     PosY,
     NegZ,
     PosZ,
+}
+
+/// An orthonormal basis (t, b) around the unit vector `n` (Duff et al. 2017, branchless).
+pub fn basis(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
 }
 
 #[cfg(test)]

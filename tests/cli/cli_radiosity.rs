@@ -3,9 +3,9 @@
 
 use crate::common;
 
+use crate::fixtures;
 use common::{bake, data, expect_code, list_files, python, require_python};
 use relume::error::exit;
-use relume::radiosity::fixtures;
 use relume::scene::Scene;
 use std::path::Path;
 

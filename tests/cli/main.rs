@@ -5,6 +5,8 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+#[path = "../support/fixtures.rs"]
+mod fixtures;
 
 mod bad_inputs;
 mod cli_foundation;

@@ -44,9 +44,9 @@ fn light_end(l: &GpuLight, p: Vec3) -> Vec3 {
 
 #[test]
 fn direct_light_kernel_with_punctual_lights_and_shadow_maps_matches_its_twin() {
-    use relume::radiosity::fixtures::SceneBuilder;
     use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
     use relume::render::direct::patch_exitance;
+    use relume::scene::builder::SceneBuilder;
     let Some(gpu) = gpu() else { return };
     // A floor and a floating square above it.
     let mut b = SceneBuilder::new();

@@ -5,8 +5,8 @@
 use crate::common;
 use crate::room_light;
 
+use crate::fixtures::random_soup;
 use common::*;
-use relume::radiosity::fixtures::random_soup;
 use relume::radiosity::patches::adaptive::AdaptiveParams;
 use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::PatchSet;

@@ -2,15 +2,16 @@
 //! for both estimators with tolerances that tighten as samples grow; reciprocity, closed-box row
 //! sums, F_ii = 0; translation and scale invariance.
 
+use crate::fixtures;
 use glam::DVec3;
 use proptest::prelude::*;
 use relume::progress::Silent;
-use relume::radiosity::fixtures::{self, SceneBuilder};
 use relume::radiosity::formfactor::{
     analytic, form_factors, Estimator, FormFactorParams, FormFactors,
 };
 use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::PatchSet;
+use relume::scene::builder::SceneBuilder;
 use relume::scene::Scene;
 
 fn patches(scene: &Scene, resolution: Resolution) -> PatchSet {

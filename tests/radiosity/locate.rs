@@ -1,8 +1,8 @@
 //! The patch locator's nearest-piece search against a brute-force scan.
 
+use crate::fixtures;
 use glam::DVec3;
 use proptest::prelude::*;
-use relume::radiosity::fixtures;
 use relume::radiosity::formfactor::locate::PatchLocator;
 use relume::radiosity::geometry;
 use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};

@@ -5,6 +5,8 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+#[path = "../support/fixtures.rs"]
+mod fixtures;
 #[path = "../support/room_light.rs"]
 mod room_light;
 
@@ -12,6 +14,7 @@ mod adaptive;
 mod export_gltf;
 mod formfactors;
 mod locate;
+mod objects;
 mod rooms;
 mod transport;
 mod visibility;

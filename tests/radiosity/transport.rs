@@ -1,9 +1,9 @@
 //! Transport matrices: furnace tests (k finite and infinite), S_1 = M, S_k → S_∞, agreement with
 //! the f64 Gauss–Seidel reference, and the extremes (ρ = 0, 0.999, 1; memory budget).
 
+use crate::fixtures;
 use proptest::prelude::*;
 use relume::progress::Silent;
-use relume::radiosity::fixtures;
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
 use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::transport::reference::gauss_seidel;

@@ -4,9 +4,9 @@
 //! vertices and edge midpoints (shared edges, where a lost box or a leaf test that differs from
 //! the scalar one would show), along the axes (zero direction components) and at random.
 
+use crate::fixtures::random_soup;
 use glam::DVec3;
 use proptest::prelude::*;
-use relume::radiosity::fixtures::random_soup;
 use relume::radiosity::geometry::Frame;
 use relume::raytrace::visibility::{Ray, Visibility};
 use relume::scene::builder::SceneBuilder;

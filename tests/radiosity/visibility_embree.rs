@@ -135,7 +135,7 @@ fn scenes() -> (Scene, Scene) {
         relume::scene::SceneOptions { scale: 0.001 },
     )
     .unwrap();
-    (cornell, relume::radiosity::fixtures::random_soup(2000, 11))
+    (cornell, crate::fixtures::random_soup(2000, 11))
 }
 
 #[test]

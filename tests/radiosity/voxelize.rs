@@ -2,10 +2,10 @@
 //! power conservation, degenerate triangles, target patch counts, transfer weights, smoothness,
 //! and no leaks through a wall thinner than a voxel.
 
+use crate::fixtures;
 use glam::DVec3;
 use proptest::prelude::*;
 use relume::progress::Silent;
-use relume::radiosity::fixtures::{self, SceneBuilder};
 use relume::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
 use relume::radiosity::geometry::{self, dominant_axis};
 use relume::radiosity::patches::corners::interpolate;
@@ -13,6 +13,7 @@ use relume::radiosity::patches::overlap::{visible_parts, Face};
 use relume::radiosity::patches::voxelize::{clip_to_voxels, voxelize, Resolution, VoxelizeParams};
 use relume::radiosity::transport::{transport, Bounces, Power, TransportParams};
 use relume::radiosity::PatchSet;
+use relume::scene::builder::SceneBuilder;
 use relume::scene::Scene;
 
 fn patches(scene: &Scene, resolution: Resolution) -> PatchSet {

@@ -1,33 +1,11 @@
-//! Synthetic scenes with known answers, for tests and benchmarks: the analytic configurations
-//! of [`crate::radiosity::formfactor::analytic`], closed boxes (furnace tests) and two rooms separated by a
+//! Synthetic scenes with known answers, for the tests and benchmarks: the analytic configurations
+//! of `relume::radiosity::formfactor::analytic`, closed boxes (furnace tests) and two rooms separated by a
 //! thin wall (the transfer's leak test).
+#![allow(dead_code)]
 
-pub use crate::scene::builder::SceneBuilder;
-use crate::scene::Scene;
 use glam::DVec3;
-
-impl SceneBuilder {
-    /// A regular `segments`-gon of circumradius `r` at `centre` facing `normal`.
-    pub fn disc(
-        &mut self,
-        object: &str,
-        centre: DVec3,
-        normal: DVec3,
-        r: f64,
-        segments: usize,
-        material: u32,
-    ) {
-        let n = normal.normalize();
-        let (t, b) = crate::radiosity::geometry::basis(n);
-        let pts: Vec<DVec3> = (0..segments)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / segments as f64;
-                centre + r * (t * a.cos() + b * a.sin())
-            })
-            .collect();
-        self.polygon(object, &pts, material);
-    }
-}
+use relume::scene::builder::SceneBuilder;
+use relume::scene::Scene;
 
 /// `count` random triangles in the unit cube (each within 0.1 of a random centre; xorshift
 /// from `seed`): the random soup of the visibility and memory tests.
