@@ -3,12 +3,18 @@
 //! voxels when the point sits on a voxel boundary). When the voxel holds exactly one patch of that
 //! orientation, that patch is the answer without a distance test. A point under a coplanar cover (the Cornell
 //! ceiling above the light) lies on the cover's piece, so it finds the cover's patch.
+//!
+//! Ray hits ([`PatchLocator::locate_hit`]) know their triangle, and a table of each triangle's
+//! pieces by voxel ([`HitIndex`], built on the first hit) finds the answer from the hit
+//! triangle's own piece and the few pieces within a hair of it, in O(1) per hit; it is the
+//! answer of the full search, exactly (the argument is at [`HitIndex`]).
 
 use super::geometry::group_key;
 use super::geometry::{self, dominant_axis};
 use super::PatchSet;
 use crate::scene::Scene;
 use glam::DVec3;
+use std::sync::OnceLock;
 
 /// Distance (grid units) within which a point counts as lying on a patch's piece.
 pub const ON_SURFACE: f64 = 1e-3;
@@ -39,6 +45,186 @@ pub struct PatchLocator {
     /// Dense (first patch, count) per group key when the grid is small enough, else empty (then
     /// a binary search over `keys`).
     table: Vec<(u32, u32)>,
+    /// The ray hits' table, built on the first [`PatchLocator::locate_hit`] (the corner
+    /// transfer's locator never needs it).
+    hits: OnceLock<HitIndex>,
+}
+
+/// Where a hit on a triangle finds its patch without searching: for every piece lying in a
+/// (voxel, axis) group of several patches, an entry keyed by (triangle, group key), and the
+/// pieces of the group lying within [`NEAR`] of it.
+///
+/// Why the answer is [`PatchLocator::locate_on`]'s, bit for bit. Where the hit's voxel holds one
+/// patch of the triangle's axis (or none) both take the same early exit or fallback. Otherwise
+/// `locate_on` returns the group's patch whose pieces come nearest to `p` (distance from
+/// [`geometry::closest_point_on_polygon`], ties to the lower patch index) when that distance
+/// is at most [`ON_SURFACE`]. Let `d0` be the distance from `p` to the hit triangle's pieces in
+/// the group, at the piece `a`. If `d0 > ON_SURFACE`, or the triangle has no piece there (a
+/// hidden or dropped part, a point rounded across a voxel face), the table answers nothing and
+/// `locate_on` runs. Else every piece `b` within `d0` of `p` lies within `2 d0 ≤ 2 ON_SURFACE`
+/// of `a`, so inside `a`'s bounding box grown by [`NEAR`] `= 4 ON_SURFACE`: it is on `a`'s near
+/// list. Every patch whose distance is at most `d0` therefore gets its exact distance from the
+/// pieces the table visits (its nearest piece is among them, each computed by the same
+/// function on the same vertices), and every other patch is farther than `d0`, which the
+/// visited minimum does not exceed: the minimum and its tie-break are the full search's, and
+/// the minimum is at most `d0 ≤ ON_SURFACE`, which `locate_on` accepts. A piece whose bounding
+/// sphere lies farther than the best so far (plus 1e-9) is skipped, as in the full search. A
+/// near list that would hold only pieces of the entry's own patch is left empty: then that
+/// patch is the only one within `d0`, and no distance but `d0` is needed. (Coplanar covers —
+/// the Cornell light under its ceiling — take the same path: the covered triangle has no piece
+/// under the cover, so a hit reported on it there either falls back or finds the cover's piece
+/// on its near list.)
+struct HitIndex {
+    /// Triangle t's entries are `entries[tri_first[t]..tri_first[t + 1]]`, sorted by key.
+    tri_first: Vec<u32>,
+    entries: Vec<HitEntry>,
+    /// Near lists (piece indices), entry e's at `near[e.near.0..e.near.1]`.
+    near: Vec<u32>,
+    /// Patch of each piece.
+    piece_patch: Vec<u32>,
+}
+
+#[derive(Clone, Copy)]
+struct HitEntry {
+    /// Group key (voxel, axis) of the piece's patch.
+    key: u64,
+    piece: u32,
+    near: (u32, u32),
+}
+
+/// Reach of a near list (grid units): pieces whose bounding boxes come this close.
+const NEAR: f64 = 4.0 * ON_SURFACE;
+
+impl HitIndex {
+    fn new(loc: &PatchLocator) -> Self {
+        let mut piece_patch = vec![0u32; loc.pieces.len()];
+        for (i, &(first, count)) in loc.ranges.iter().enumerate() {
+            piece_patch[first..first + count].fill(i as u32);
+        }
+        let bounds: Vec<(DVec3, DVec3)> = loc
+            .pieces
+            .iter()
+            .map(|(poly, _)| {
+                poly.iter().fold(
+                    (DVec3::INFINITY, DVec3::NEG_INFINITY),
+                    |(lo, hi), &v| (lo.min(v), hi.max(v)),
+                )
+            })
+            .collect();
+        // (triangle, key, piece, near list) of every piece in a group of several patches.
+        let mut rows: Vec<(u32, u64, u32, (u32, u32))> = Vec::new();
+        let mut near = Vec::new();
+        let mut start = 0;
+        while start < loc.keys.len() {
+            let key = loc.keys[start];
+            let end = start + loc.keys[start..].partition_point(|&k| k == key);
+            if end - start > 1 {
+                let mut members: Vec<u32> = (start..end)
+                    .flat_map(|i| {
+                        let (first, count) = loc.ranges[i];
+                        (first as u32..(first + count) as u32).collect::<Vec<_>>()
+                    })
+                    .collect();
+                // Sweep along x: pairs whose boxes come within NEAR on every axis.
+                members.sort_by(|&a, &b| {
+                    bounds[a as usize].0.x.total_cmp(&bounds[b as usize].0.x).then(a.cmp(&b))
+                });
+                let mut pairs: Vec<(u32, u32)> = Vec::new();
+                for (n, &a) in members.iter().enumerate() {
+                    let (alo, ahi) = bounds[a as usize];
+                    for &b in &members[n + 1..] {
+                        let (blo, bhi) = bounds[b as usize];
+                        if blo.x > ahi.x + NEAR {
+                            break;
+                        }
+                        if (0..3).all(|k| blo[k] <= ahi[k] + NEAR && alo[k] <= bhi[k] + NEAR) {
+                            pairs.push((a, b));
+                            pairs.push((b, a));
+                        }
+                    }
+                }
+                pairs.sort_unstable();
+                let mut lists = pairs.chunk_by(|x, y| x.0 == y.0).peekable();
+                members.sort_unstable();
+                for &a in &members {
+                    let list: &[(u32, u32)] = match lists.peek() {
+                        Some(l) if l[0].0 == a => lists.next().unwrap_or(&[]),
+                        _ => &[],
+                    };
+                    let own = piece_patch[a as usize];
+                    let at = near.len() as u32;
+                    if list.iter().any(|&(_, b)| piece_patch[b as usize] != own) {
+                        near.extend(list.iter().map(|&(_, b)| b));
+                    }
+                    let t = loc.piece_triangle[a as usize];
+                    rows.push((t, key, a, (at, near.len() as u32)));
+                }
+            }
+            start = end;
+        }
+        rows.sort_unstable_by_key(|r| (r.0, r.1, r.2));
+        let mut tri_first = vec![0u32; loc.triangle_axis.len() + 1];
+        for r in &rows {
+            tri_first[r.0 as usize + 1] += 1;
+        }
+        for t in 0..loc.triangle_axis.len() {
+            tri_first[t + 1] += tri_first[t];
+        }
+        let entries = rows
+            .into_iter()
+            .map(|(_, key, piece, near)| HitEntry { key, piece, near })
+            .collect();
+        HitIndex {
+            tri_first,
+            entries,
+            near,
+            piece_patch,
+        }
+    }
+
+    /// The patch of a hit at `p` on triangle `t` in the group `key` ([`PatchLocator::locate_on`]'s
+    /// answer), or `None` when the full search must decide.
+    fn locate(&self, loc: &PatchLocator, p: DVec3, t: u32, key: u64) -> Option<u32> {
+        let ents = &self.entries
+            [self.tri_first[t as usize] as usize..self.tri_first[t as usize + 1] as usize];
+        let lo = ents.partition_point(|e| e.key < key);
+        let run = &ents[lo..lo + ents[lo..].partition_point(|e| e.key == key)];
+        // (distance, patch): the least, ties to the lower patch.
+        let mut best = (f64::INFINITY, u32::MAX);
+        let consider = |best: &mut (f64, u32), k: u32| {
+            let (poly, n) = &loc.pieces[k as usize];
+            let d = (geometry::closest_point_on_polygon(p, poly, *n) - p).length();
+            let j = self.piece_patch[k as usize];
+            if d < best.0 || (d == best.0 && j < best.1) {
+                *best = (d, j);
+            }
+        };
+        let mut at = None;
+        for e in run {
+            let before = best;
+            consider(&mut best, e.piece);
+            if best != before {
+                at = Some(e);
+            }
+        }
+        let at = at?;
+        if best.0 > ON_SURFACE {
+            return None;
+        }
+        if at.near.0 == at.near.1 {
+            // Every piece within NEAR of the nearest one is of its patch.
+            return Some(best.1);
+        }
+        for e in run {
+            for &k in &self.near[e.near.0 as usize..e.near.1 as usize] {
+                if beyond(p, &loc.spheres[k as usize]) > best.0 + 1e-9 {
+                    continue;
+                }
+                consider(&mut best, k);
+            }
+        }
+        Some(best.1)
+    }
 }
 
 /// Pieces per bounding run in the nearest-piece search.
@@ -119,6 +305,7 @@ impl PatchLocator {
             triangle_axis,
             piece_triangle: set.pieces.iter().map(|p| p.triangle).collect(),
             table,
+            hits: OnceLock::new(),
         }
     }
 
@@ -299,8 +486,29 @@ impl PatchLocator {
         best.filter(|b| b.1 <= MAX_DISTANCE).map(|b| b.0)
     }
 
-    /// The patch of a ray hit on scene triangle `t` at `p`.
+    /// The patch of a ray hit on scene triangle `t` at `p`: [`PatchLocator::locate_hit_searching`]'s
+    /// answer, found in O(1) by the triangle's own pieces ([`HitIndex`]) unless the point lies
+    /// off them.
     pub fn locate_hit(&self, p: DVec3, t: u32) -> Option<u32> {
+        let axis = self.triangle_axis(t);
+        let v = voxel_of(p, self.dims);
+        let own = self.candidates(v, axis);
+        if own.len() == 1 {
+            return Some(own.start as u32);
+        }
+        if !own.is_empty() {
+            let key = group_key(v.map(|c| c as u32), axis, self.dims);
+            let hits = self.hits.get_or_init(|| HitIndex::new(self));
+            if let Some(i) = hits.locate(self, p, t, key) {
+                return Some(i);
+            }
+        }
+        self.locate_on(p, axis, Some(t))
+    }
+
+    /// [`PatchLocator::locate_hit`] by the nearest-piece search alone (the reference the table
+    /// is tested against).
+    pub fn locate_hit_searching(&self, p: DVec3, t: u32) -> Option<u32> {
         self.locate_on(p, self.triangle_axis(t), Some(t))
     }
 }
