@@ -51,29 +51,26 @@ pub struct PatchLocator {
 }
 
 /// Where a hit on a triangle finds its patch without searching: for every piece lying in a
-/// (voxel, axis) group of several patches, an entry keyed by (triangle, group key), and the
-/// pieces of the group lying within [`NEAR`] of it.
+/// (voxel, axis) group of several patches, an entry keyed by (triangle, group key) with the
+/// group's pieces of *other* patches that come within [`NEAR`] of it (bounding boxes).
 ///
 /// Why the answer is [`PatchLocator::locate_on`]'s, bit for bit. Where the hit's voxel holds one
 /// patch of the triangle's axis (or none) both take the same early exit or fallback. Otherwise
 /// `locate_on` returns the group's patch whose pieces come nearest to `p` (distance from
 /// [`geometry::closest_point_on_polygon`], ties to the lower patch index) when that distance
-/// is at most [`ON_SURFACE`]. Let `d0` be the distance from `p` to the hit triangle's pieces in
-/// the group, at the piece `a`. If `d0 > ON_SURFACE`, or the triangle has no piece there (a
-/// hidden or dropped part, a point rounded across a voxel face), the table answers nothing and
-/// `locate_on` runs. Else every piece `b` within `d0` of `p` lies within `2 d0 ≤ 2 ON_SURFACE`
-/// of `a`, so inside `a`'s bounding box grown by [`NEAR`] `= 4 ON_SURFACE`: it is on `a`'s near
-/// list. Every patch whose distance is at most `d0` therefore gets its exact distance from the
-/// pieces the table visits (its nearest piece is among them, each computed by the same
-/// function on the same vertices), and every other patch is farther than `d0`, which the
-/// visited minimum does not exceed: the minimum and its tie-break are the full search's, and
-/// the minimum is at most `d0 ≤ ON_SURFACE`, which `locate_on` accepts. A piece whose bounding
-/// sphere lies farther than the best so far (plus 1e-9) is skipped, as in the full search. A
-/// near list that would hold only pieces of the entry's own patch is left empty: then that
-/// patch is the only one within `d0`, and no distance but `d0` is needed. (Coplanar covers —
-/// the Cornell light under its ceiling — take the same path: the covered triangle has no piece
-/// under the cover, so a hit reported on it there either falls back or finds the cover's piece
-/// on its near list.)
+/// is at most [`ON_SURFACE`]. Let `d0` be the least distance from `p` to the hit triangle's
+/// pieces in the group (ties to the lower patch), at piece `a` of patch `P`. If the triangle
+/// has no piece there (a hidden or dropped part, a point rounded across a voxel face) or
+/// `d0 > ON_SURFACE`, the table answers nothing and `locate_on` runs. Else `P`'s distance is
+/// at most `d0`, and every other patch's is more: a piece `b` of another patch within `d0` of
+/// `p` would lie within `2 d0 ≤ 2 ON_SURFACE` of `a`, so on `a`'s near list, and each piece on
+/// it is either farther than `d0 + 1e-9` by its bounding box or has its distance computed (by
+/// the same function on the same vertices as the search) — and if that is at most `d0` (a hit
+/// on a seam between two patches) the table again answers nothing. Pieces off the list lie
+/// farther than `NEAR − d0 ≥ 3 ON_SURFACE`. So `P` is the nearest patch, strictly, within
+/// `ON_SURFACE`: `locate_on`'s answer. Coplanar covers (the Cornell light in its ceiling) need
+/// nothing more: the covered triangle has no piece under the cover, so a hit reported on it
+/// there is handed to the search, and one on the cover finds the cover's piece.
 struct HitIndex {
     /// Triangle t's entries are `entries[tri_first[t]..tri_first[t + 1]]`, sorted by key.
     tri_first: Vec<u32>,
@@ -82,6 +79,8 @@ struct HitIndex {
     near: Vec<u32>,
     /// Patch of each piece.
     piece_patch: Vec<u32>,
+    /// Bounding box (lowest, highest corner) of each piece.
+    bounds: Vec<(DVec3, DVec3)>,
 }
 
 #[derive(Clone, Copy)]
@@ -105,10 +104,10 @@ impl HitIndex {
             .pieces
             .iter()
             .map(|(poly, _)| {
-                poly.iter().fold(
-                    (DVec3::INFINITY, DVec3::NEG_INFINITY),
-                    |(lo, hi), &v| (lo.min(v), hi.max(v)),
-                )
+                poly.iter()
+                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+                        (lo.min(v), hi.max(v))
+                    })
             })
             .collect();
         // (triangle, key, piece, near list) of every piece in a group of several patches.
@@ -122,12 +121,14 @@ impl HitIndex {
                 let mut members: Vec<u32> = (start..end)
                     .flat_map(|i| {
                         let (first, count) = loc.ranges[i];
-                        (first as u32..(first + count) as u32).collect::<Vec<_>>()
+                        first as u32..(first + count) as u32
                     })
                     .collect();
-                // Sweep along x: pairs whose boxes come within NEAR on every axis.
+                // Sweep along x: pairs of different patches whose boxes come within NEAR on
+                // every axis.
                 members.sort_by(|&a, &b| {
-                    bounds[a as usize].0.x.total_cmp(&bounds[b as usize].0.x).then(a.cmp(&b))
+                    let (ba, bb) = (bounds[a as usize].0.x, bounds[b as usize].0.x);
+                    ba.total_cmp(&bb).then(a.cmp(&b))
                 });
                 let mut pairs: Vec<(u32, u32)> = Vec::new();
                 for (n, &a) in members.iter().enumerate() {
@@ -137,25 +138,22 @@ impl HitIndex {
                         if blo.x > ahi.x + NEAR {
                             break;
                         }
-                        if (0..3).all(|k| blo[k] <= ahi[k] + NEAR && alo[k] <= bhi[k] + NEAR) {
+                        if piece_patch[a as usize] != piece_patch[b as usize]
+                            && (0..3).all(|k| blo[k] <= ahi[k] + NEAR && alo[k] <= bhi[k] + NEAR)
+                        {
                             pairs.push((a, b));
                             pairs.push((b, a));
                         }
                     }
                 }
                 pairs.sort_unstable();
-                let mut lists = pairs.chunk_by(|x, y| x.0 == y.0).peekable();
                 members.sort_unstable();
+                let mut rest = pairs.as_slice();
                 for &a in &members {
-                    let list: &[(u32, u32)] = match lists.peek() {
-                        Some(l) if l[0].0 == a => lists.next().unwrap_or(&[]),
-                        _ => &[],
-                    };
-                    let own = piece_patch[a as usize];
+                    let count = rest.iter().take_while(|e| e.0 == a).count();
                     let at = near.len() as u32;
-                    if list.iter().any(|&(_, b)| piece_patch[b as usize] != own) {
-                        near.extend(list.iter().map(|&(_, b)| b));
-                    }
+                    near.extend(rest[..count].iter().map(|e| e.1));
+                    rest = &rest[count..];
                     let t = loc.piece_triangle[a as usize];
                     rows.push((t, key, a, (at, near.len() as u32)));
                 }
@@ -179,6 +177,7 @@ impl HitIndex {
             entries,
             near,
             piece_patch,
+            bounds,
         }
     }
 
@@ -189,41 +188,32 @@ impl HitIndex {
             [self.tri_first[t as usize] as usize..self.tri_first[t as usize + 1] as usize];
         let lo = ents.partition_point(|e| e.key < key);
         let run = &ents[lo..lo + ents[lo..].partition_point(|e| e.key == key)];
-        // (distance, patch): the least, ties to the lower patch.
-        let mut best = (f64::INFINITY, u32::MAX);
-        let consider = |best: &mut (f64, u32), k: u32| {
+        let distance = |k: u32| {
             let (poly, n) = &loc.pieces[k as usize];
-            let d = (geometry::closest_point_on_polygon(p, poly, *n) - p).length();
-            let j = self.piece_patch[k as usize];
-            if d < best.0 || (d == best.0 && j < best.1) {
-                *best = (d, j);
-            }
+            (geometry::closest_point_on_polygon(p, poly, *n) - p).length()
         };
-        let mut at = None;
+        // (distance, patch, entry): the least, ties to the lower patch.
+        let mut best: Option<(f64, u32, &HitEntry)> = None;
         for e in run {
-            let before = best;
-            consider(&mut best, e.piece);
-            if best != before {
-                at = Some(e);
+            let (d, j) = (distance(e.piece), self.piece_patch[e.piece as usize]);
+            if best.is_none_or(|b| d < b.0 || (d == b.0 && j < b.1)) {
+                best = Some((d, j, e));
             }
         }
-        let at = at?;
-        if best.0 > ON_SURFACE {
+        let (d0, patch, at) = best?;
+        if !(d0 <= ON_SURFACE) {
             return None;
         }
-        if at.near.0 == at.near.1 {
-            // Every piece within NEAR of the nearest one is of its patch.
-            return Some(best.1);
-        }
-        for e in run {
-            for &k in &self.near[e.near.0 as usize..e.near.1 as usize] {
-                if beyond(p, &loc.spheres[k as usize]) > best.0 + 1e-9 {
-                    continue;
-                }
-                consider(&mut best, k);
+        for &k in &self.near[at.near.0 as usize..at.near.1 as usize] {
+            let (lo, hi) = self.bounds[k as usize];
+            if (lo - p).max(p - hi).max(DVec3::ZERO).length() > d0 + 1e-9 {
+                continue;
+            }
+            if distance(k) <= d0 {
+                return None;
             }
         }
-        Some(best.1)
+        Some(patch)
     }
 }
 
