@@ -185,19 +185,25 @@ fn bundled_scenes_hits_find_the_searching_patch() {
         ("scenes/generated/door-sealed.obj", 1.0, 1500),
     ];
     for (path, scale, target) in scenes {
-        let scene = relume::scene::load_scene(&root.join(path), relume::scene::SceneOptions { scale })
-            .unwrap()
-            .0;
+        let scene =
+            relume::scene::load_scene(&root.join(path), relume::scene::SceneOptions { scale })
+                .unwrap()
+                .0;
         let set = voxelize(
             &scene,
-            &VoxelizeParams { resolution: Resolution::TargetPatches(target), samples_per_patch: 1 },
+            &VoxelizeParams {
+                resolution: Resolution::TargetPatches(target),
+                samples_per_patch: 1,
+            },
         )
         .unwrap();
         let ctx = Context::new(&scene, &set);
         let (mut hits, mut shared) = (0, 0);
         for i in 0..set.len() {
             for (origin, dir) in hemisphere::rays(&ctx, i, 64, 0) {
-                let Some(hit) = ctx.vis.closest_hit(origin, dir) else { continue };
+                let Some(hit) = ctx.vis.closest_hit(origin, dir) else {
+                    continue;
+                };
                 if !hit.front {
                     continue;
                 }
@@ -214,6 +220,9 @@ fn bundled_scenes_hits_find_the_searching_patch() {
                 );
             }
         }
-        assert!(hits > 0 && (path.contains("cornell") || shared > 0), "{path}: {hits} hits, {shared} shared");
+        assert!(
+            hits > 0 && (path.contains("cornell") || shared > 0),
+            "{path}: {hits} hits, {shared} shared"
+        );
     }
 }
