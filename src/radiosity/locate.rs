@@ -392,15 +392,26 @@ impl PatchLocator {
         // their nearest run's lower bound, so the bound tightens at the first, and a patch whose
         // every run lies beyond it is skipped whole. Ties still go to the lower patch index:
         // a patch that ties the nearest is never pruned, and the minimum is taken over all.
+        // The order is kept on the stack for a voxel of up to 16 such patches (nearly all);
+        // the keys are distinct (the index breaks ties), so an unstable sort gives the order a
+        // stable one does.
         let mut bound = bound;
-        let mut order: Vec<(f64, usize)> = self
-            .candidates(voxel, axis)
-            .map(|i| (self.lower_bound(p, i), i))
-            .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let candidates = self.candidates(voxel, axis);
+        let mut small = [(0.0, 0); 16];
+        let mut large = Vec::new();
+        let order: &mut [(f64, usize)] = if candidates.len() <= small.len() {
+            for (slot, i) in small.iter_mut().zip(candidates.clone()) {
+                *slot = (self.lower_bound(p, i), i);
+            }
+            &mut small[..candidates.len()]
+        } else {
+            large.extend(candidates.map(|i| (self.lower_bound(p, i), i)));
+            &mut large
+        };
+        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         order
-            .into_iter()
-            .map(|(lower, i)| {
+            .iter()
+            .map(|&(lower, i)| {
                 if lower > bound + 1e-9 {
                     return (i as u32, f64::INFINITY, p);
                 }
