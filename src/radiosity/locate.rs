@@ -201,7 +201,7 @@ impl HitIndex {
             }
         }
         let (d0, patch, at) = best?;
-        if !(d0 <= ON_SURFACE) {
+        if d0.is_nan() || d0 > ON_SURFACE {
             return None;
         }
         for &k in &self.near[at.near.0 as usize..at.near.1 as usize] {
