@@ -128,3 +128,101 @@ proptest! {
         prop_assert!(shared > 0, "no voxel with several patches");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// A hit's patch from the per-triangle table is the full nearest-piece search's, for points
+    /// on the hit triangle, on its edges and corners (seams between patches and voxel faces),
+    /// and lifted off it by up to twice the on-surface tolerance (where the table hands over to
+    /// the search), on soups whose voxels hold several patches of one orientation.
+    #[test]
+    fn the_hit_table_gives_the_searching_answer(
+        seed in 0u64..1000,
+        size in prop::sample::select(vec![0.25f64, 0.4]),
+        points in prop::collection::vec(
+            (0usize..10_000, 0.0f64..1.0, 0.0f64..1.0, 0usize..4, -2.0f64..2.0),
+            300,
+        ),
+    ) {
+        let scene = fixtures::random_soup(300, seed);
+        let set = voxelize(
+            &scene,
+            &VoxelizeParams { resolution: Resolution::VoxelSize(size), samples_per_patch: 1 },
+        )
+        .unwrap();
+        let loc = PatchLocator::new(&set, &scene);
+        let frame = set.frame();
+        let mut shared = 0;
+        for (pick, u, v, kind, lift) in points {
+            let t = (pick % scene.triangles.len()) as u32;
+            let [a, b, c] = scene.corners(t as usize).map(|x| frame.to_grid(x.to_array()));
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let n = (b - a).cross(c - a).normalize_or_zero();
+            let p = match kind {
+                0 => a + (b - a) * u + (c - a) * v,
+                1 => a + (b - a) * u,
+                2 => [a, b, c][pick % 3],
+                _ => a + (b - a) * u + (c - a) * v + n * (lift * 1e-3),
+            };
+            let axis = loc.triangle_axis(t);
+            let voxel = relume::radiosity::locate::voxel_of(p, set.dims);
+            shared += (loc.candidates(voxel, axis).len() > 1) as usize;
+            prop_assert_eq!(loc.locate_hit(p, t), loc.locate_hit_searching(p, t), "t {} p {}", t, p);
+        }
+        prop_assert!(shared > 0, "no point fell in a voxel with several patches");
+    }
+}
+
+/// The hemisphere rays' hits in the bundled scenes find the patch the full search finds.
+#[test]
+fn bundled_scenes_hits_find_the_searching_patch() {
+    use relume::radiosity::formfactor::{hemisphere, Context};
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scenes = [
+        ("scenes/cornell-box/cornell_box.obj", 0.001, 600),
+        ("scenes/generated/furnished-room.obj", 1.0, 1500),
+        ("scenes/generated/door-ajar.obj", 1.0, 1500),
+        ("scenes/generated/door-sealed.obj", 1.0, 1500),
+    ];
+    for (path, scale, target) in scenes {
+        let scene =
+            relume::scene::load_scene(&root.join(path), relume::scene::SceneOptions { scale })
+                .unwrap()
+                .0;
+        let set = voxelize(
+            &scene,
+            &VoxelizeParams {
+                resolution: Resolution::TargetPatches(target),
+                samples_per_patch: 1,
+            },
+        )
+        .unwrap();
+        let ctx = Context::new(&scene, &set);
+        let (mut hits, mut shared) = (0, 0);
+        for i in 0..set.len() {
+            for (origin, dir) in hemisphere::rays(&ctx, i, 64, 0) {
+                let Some(hit) = ctx.vis.closest_hit(origin, dir) else {
+                    continue;
+                };
+                if !hit.front {
+                    continue;
+                }
+                let p = origin + dir * hit.t as f64;
+                let axis = ctx.locator.triangle_axis(hit.triangle);
+                let voxel = relume::radiosity::locate::voxel_of(p, set.dims);
+                shared += (ctx.locator.candidates(voxel, axis).len() > 1) as usize;
+                hits += 1;
+                assert_eq!(
+                    ctx.locator.locate_hit(p, hit.triangle),
+                    ctx.locator.locate_hit_searching(p, hit.triangle),
+                    "{path}: patch {i}, hit {p} on triangle {}",
+                    hit.triangle
+                );
+            }
+        }
+        assert!(
+            hits > 0 && (path.contains("cornell") || shared > 0),
+            "{path}: {hits} hits, {shared} shared"
+        );
+    }
+}

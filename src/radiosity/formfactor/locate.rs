@@ -3,12 +3,18 @@
 //! voxels when the point sits on a voxel boundary). When the voxel holds exactly one patch of that
 //! orientation, that patch is the answer without a distance test. A point under a coplanar cover (the Cornell
 //! ceiling above the light) lies on the cover's piece, so it finds the cover's patch.
+//!
+//! Ray hits ([`PatchLocator::locate_hit`]) know their triangle, and a table of each triangle's
+//! pieces by voxel ([`HitIndex`], built on the first hit) finds the answer from the hit
+//! triangle's own piece and the few pieces within a hair of it, in O(1) per hit; it is the
+//! answer of the full search, exactly (the argument is at [`HitIndex`]).
 
 use crate::radiosity::geometry::group_key;
 use crate::radiosity::geometry::{self, dominant_axis};
 use crate::radiosity::PatchSet;
 use crate::scene::Scene;
 use glam::DVec3;
+use std::sync::OnceLock;
 
 /// Distance (grid units) within which a point counts as lying on a patch's piece.
 pub const ON_SURFACE: f64 = 1e-3;
@@ -39,6 +45,176 @@ pub struct PatchLocator {
     /// Dense (first patch, count) per group key when the grid is small enough, else empty (then
     /// a binary search over `keys`).
     table: Vec<(u32, u32)>,
+    /// The ray hits' table, built on the first [`PatchLocator::locate_hit`] (the corner
+    /// transfer's locator never needs it).
+    hits: OnceLock<HitIndex>,
+}
+
+/// Where a hit on a triangle finds its patch without searching: for every piece lying in a
+/// (voxel, axis) group of several patches, an entry keyed by (triangle, group key) with the
+/// group's pieces of *other* patches that come within [`NEAR`] of it (bounding boxes).
+///
+/// Why the answer is [`PatchLocator::locate_on`]'s, bit for bit. Where the hit's voxel holds one
+/// patch of the triangle's axis (or none) both take the same early exit or fallback. Otherwise
+/// `locate_on` returns the group's patch whose pieces come nearest to `p` (distance from
+/// [`geometry::closest_point_on_polygon`], ties to the lower patch index) when that distance
+/// is at most [`ON_SURFACE`]. Let `d0` be the least distance from `p` to the hit triangle's
+/// pieces in the group (ties to the lower patch), at piece `a` of patch `P`. If the triangle
+/// has no piece there (a hidden or dropped part, a point rounded across a voxel face) or
+/// `d0 > ON_SURFACE`, the table answers nothing and `locate_on` runs. Else `P`'s distance is
+/// at most `d0`, and every other patch's is more: a piece `b` of another patch within `d0` of
+/// `p` would lie within `2 d0 ≤ 2 ON_SURFACE` of `a`, so on `a`'s near list, and each piece on
+/// it is either farther than `d0 + 1e-9` by its bounding box or has its distance computed (by
+/// the same function on the same vertices as the search) — and if that is at most `d0` (a hit
+/// on a seam between two patches) the table again answers nothing. Pieces off the list lie
+/// farther than `NEAR − d0 ≥ 3 ON_SURFACE`. So `P` is the nearest patch, strictly, within
+/// `ON_SURFACE`: `locate_on`'s answer. Coplanar covers (the Cornell light in its ceiling) need
+/// nothing more: the covered triangle has no piece under the cover, so a hit reported on it
+/// there is handed to the search, and one on the cover finds the cover's piece.
+struct HitIndex {
+    /// Triangle t's entries are `entries[tri_first[t]..tri_first[t + 1]]`, sorted by key.
+    tri_first: Vec<u32>,
+    entries: Vec<HitEntry>,
+    /// Near lists (piece indices), entry e's at `near[e.near.0..e.near.1]`.
+    near: Vec<u32>,
+    /// Patch of each piece.
+    piece_patch: Vec<u32>,
+    /// Bounding box (lowest, highest corner) of each piece.
+    bounds: Vec<(DVec3, DVec3)>,
+}
+
+#[derive(Clone, Copy)]
+struct HitEntry {
+    /// Group key (voxel, axis) of the piece's patch.
+    key: u64,
+    piece: u32,
+    near: (u32, u32),
+}
+
+/// Reach of a near list (grid units): pieces whose bounding boxes come this close.
+const NEAR: f64 = 4.0 * ON_SURFACE;
+
+impl HitIndex {
+    fn new(loc: &PatchLocator) -> Self {
+        let mut piece_patch = vec![0u32; loc.pieces.len()];
+        for (i, &(first, count)) in loc.ranges.iter().enumerate() {
+            piece_patch[first..first + count].fill(i as u32);
+        }
+        let bounds: Vec<(DVec3, DVec3)> = loc
+            .pieces
+            .iter()
+            .map(|(poly, _)| {
+                poly.iter()
+                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+                        (lo.min(v), hi.max(v))
+                    })
+            })
+            .collect();
+        // (triangle, key, piece, near list) of every piece in a group of several patches.
+        let mut rows: Vec<(u32, u64, u32, (u32, u32))> = Vec::new();
+        let mut near = Vec::new();
+        let mut start = 0;
+        while start < loc.keys.len() {
+            let key = loc.keys[start];
+            let end = start + loc.keys[start..].partition_point(|&k| k == key);
+            if end - start > 1 {
+                let mut members: Vec<u32> = (start..end)
+                    .flat_map(|i| {
+                        let (first, count) = loc.ranges[i];
+                        first as u32..(first + count) as u32
+                    })
+                    .collect();
+                // Sweep along x: pairs of different patches whose boxes come within NEAR on
+                // every axis.
+                members.sort_by(|&a, &b| {
+                    let (ba, bb) = (bounds[a as usize].0.x, bounds[b as usize].0.x);
+                    ba.total_cmp(&bb).then(a.cmp(&b))
+                });
+                let mut pairs: Vec<(u32, u32)> = Vec::new();
+                for (n, &a) in members.iter().enumerate() {
+                    let (alo, ahi) = bounds[a as usize];
+                    for &b in &members[n + 1..] {
+                        let (blo, bhi) = bounds[b as usize];
+                        if blo.x > ahi.x + NEAR {
+                            break;
+                        }
+                        if piece_patch[a as usize] != piece_patch[b as usize]
+                            && (0..3).all(|k| blo[k] <= ahi[k] + NEAR && alo[k] <= bhi[k] + NEAR)
+                        {
+                            pairs.push((a, b));
+                            pairs.push((b, a));
+                        }
+                    }
+                }
+                pairs.sort_unstable();
+                members.sort_unstable();
+                let mut rest = pairs.as_slice();
+                for &a in &members {
+                    let count = rest.iter().take_while(|e| e.0 == a).count();
+                    let at = near.len() as u32;
+                    near.extend(rest[..count].iter().map(|e| e.1));
+                    rest = &rest[count..];
+                    let t = loc.piece_triangle[a as usize];
+                    rows.push((t, key, a, (at, near.len() as u32)));
+                }
+            }
+            start = end;
+        }
+        rows.sort_unstable_by_key(|r| (r.0, r.1, r.2));
+        let mut tri_first = vec![0u32; loc.triangle_axis.len() + 1];
+        for r in &rows {
+            tri_first[r.0 as usize + 1] += 1;
+        }
+        for t in 0..loc.triangle_axis.len() {
+            tri_first[t + 1] += tri_first[t];
+        }
+        let entries = rows
+            .into_iter()
+            .map(|(_, key, piece, near)| HitEntry { key, piece, near })
+            .collect();
+        HitIndex {
+            tri_first,
+            entries,
+            near,
+            piece_patch,
+            bounds,
+        }
+    }
+
+    /// The patch of a hit at `p` on triangle `t` in the group `key` ([`PatchLocator::locate_on`]'s
+    /// answer), or `None` when the full search must decide.
+    fn locate(&self, loc: &PatchLocator, p: DVec3, t: u32, key: u64) -> Option<u32> {
+        let ents = &self.entries
+            [self.tri_first[t as usize] as usize..self.tri_first[t as usize + 1] as usize];
+        let lo = ents.partition_point(|e| e.key < key);
+        let run = &ents[lo..lo + ents[lo..].partition_point(|e| e.key == key)];
+        let distance = |k: u32| {
+            let (poly, n) = &loc.pieces[k as usize];
+            (geometry::closest_point_on_polygon(p, poly, *n) - p).length()
+        };
+        // (distance, patch, entry): the least, ties to the lower patch.
+        let mut best: Option<(f64, u32, &HitEntry)> = None;
+        for e in run {
+            let (d, j) = (distance(e.piece), self.piece_patch[e.piece as usize]);
+            if best.is_none_or(|b| d < b.0 || (d == b.0 && j < b.1)) {
+                best = Some((d, j, e));
+            }
+        }
+        let (d0, patch, at) = best?;
+        if d0.is_nan() || d0 > ON_SURFACE {
+            return None;
+        }
+        for &k in &self.near[at.near.0 as usize..at.near.1 as usize] {
+            let (lo, hi) = self.bounds[k as usize];
+            if (lo - p).max(p - hi).max(DVec3::ZERO).length() > d0 + 1e-9 {
+                continue;
+            }
+            if distance(k) <= d0 {
+                return None;
+            }
+        }
+        Some(patch)
+    }
 }
 
 /// Pieces per bounding run in the nearest-piece search.
@@ -119,6 +295,7 @@ impl PatchLocator {
             triangle_axis,
             piece_triangle: set.pieces.iter().map(|p| p.triangle).collect(),
             table,
+            hits: OnceLock::new(),
         }
     }
 
@@ -215,15 +392,26 @@ impl PatchLocator {
         // their nearest run's lower bound, so the bound tightens at the first, and a patch whose
         // every run lies beyond it is skipped whole. Ties still go to the lower patch index:
         // a patch that ties the nearest is never pruned, and the minimum is taken over all.
+        // The order is kept on the stack for a voxel of up to 16 such patches (nearly all);
+        // the keys are distinct (the index breaks ties), so an unstable sort gives the order a
+        // stable one does.
         let mut bound = bound;
-        let mut order: Vec<(f64, usize)> = self
-            .candidates(voxel, axis)
-            .map(|i| (self.lower_bound(p, i), i))
-            .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let candidates = self.candidates(voxel, axis);
+        let mut small = [(0.0, 0); 16];
+        let mut large = Vec::new();
+        let order: &mut [(f64, usize)] = if candidates.len() <= small.len() {
+            for (slot, i) in small.iter_mut().zip(candidates.clone()) {
+                *slot = (self.lower_bound(p, i), i);
+            }
+            &mut small[..candidates.len()]
+        } else {
+            large.extend(candidates.map(|i| (self.lower_bound(p, i), i)));
+            &mut large
+        };
+        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         order
-            .into_iter()
-            .map(|(lower, i)| {
+            .iter()
+            .map(|&(lower, i)| {
                 if lower > bound + 1e-9 {
                     return (i as u32, f64::INFINITY, p);
                 }
@@ -299,8 +487,29 @@ impl PatchLocator {
         best.filter(|b| b.1 <= MAX_DISTANCE).map(|b| b.0)
     }
 
-    /// The patch of a ray hit on scene triangle `t` at `p`.
+    /// The patch of a ray hit on scene triangle `t` at `p`: [`PatchLocator::locate_hit_searching`]'s
+    /// answer, found in O(1) by the triangle's own pieces ([`HitIndex`]) unless the point lies
+    /// off them.
     pub fn locate_hit(&self, p: DVec3, t: u32) -> Option<u32> {
+        let axis = self.triangle_axis(t);
+        let v = voxel_of(p, self.dims);
+        let own = self.candidates(v, axis);
+        if own.len() == 1 {
+            return Some(own.start as u32);
+        }
+        if !own.is_empty() {
+            let key = group_key(v.map(|c| c as u32), axis, self.dims);
+            let hits = self.hits.get_or_init(|| HitIndex::new(self));
+            if let Some(i) = hits.locate(self, p, t, key) {
+                return Some(i);
+            }
+        }
+        self.locate_on(p, axis, Some(t))
+    }
+
+    /// [`PatchLocator::locate_hit`] by the nearest-piece search alone (the reference the table
+    /// is tested against).
+    pub fn locate_hit_searching(&self, p: DVec3, t: u32) -> Option<u32> {
         self.locate_on(p, self.triangle_axis(t), Some(t))
     }
 }
