@@ -165,7 +165,7 @@ proptest! {
                 _ => a + (b - a) * u + (c - a) * v + n * (lift * 1e-3),
             };
             let axis = loc.triangle_axis(t);
-            let voxel = relume::radiosity::locate::voxel_of(p, set.dims);
+            let voxel = relume::radiosity::formfactor::locate::voxel_of(p, set.dims);
             shared += (loc.candidates(voxel, axis).len() > 1) as usize;
             prop_assert_eq!(loc.locate_hit(p, t), loc.locate_hit_searching(p, t), "t {} p {}", t, p);
         }
@@ -209,7 +209,7 @@ fn bundled_scenes_hits_find_the_searching_patch() {
                 }
                 let p = origin + dir * hit.t as f64;
                 let axis = ctx.locator.triangle_axis(hit.triangle);
-                let voxel = relume::radiosity::locate::voxel_of(p, set.dims);
+                let voxel = relume::radiosity::formfactor::locate::voxel_of(p, set.dims);
                 shared += (ctx.locator.candidates(voxel, axis).len() > 1) as usize;
                 hits += 1;
                 assert_eq!(
