@@ -17,6 +17,7 @@ mod freeform_mesh_texture;
 mod freeform_quadrics;
 mod freeform_rmlrc;
 mod freeform_texture;
+mod history;
 mod independent_decoders;
 mod loaders;
 mod reorder_bounded;
