@@ -168,19 +168,6 @@ pub fn normals(map: &HeightMap) -> Vec<[f64; 3]> {
         .collect()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn clear_sky_dni_is_about_a_kilowatt_at_the_zenith_and_falls_toward_the_horizon() {
-        // Meinel: 1361 · 0.7^1 = 952.7 W/m² at air mass 1.
-        assert!((clear_sky_dni(90.0) - 952.7).abs() < 1.0);
-        assert!(clear_sky_dni(10.0) < clear_sky_dni(30.0));
-        assert_eq!(clear_sky_dni(-1.0), 0.0);
-    }
-}
-
 /// Seconds from a duration as `--step` spells it: `30`, `30s`, `10m` (or `min`), `1h`; refuses
 /// unknown units and anything not a positive finite number.
 pub fn parse_step(text: &str) -> Result<f64> {
@@ -234,4 +221,17 @@ pub fn mean_hours(hours: &[f32], nodata: &[bool]) -> f64 {
         .map(|i| hours[i] as f64)
         .collect();
     valid.iter().sum::<f64>() / valid.len().max(1) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clear_sky_dni_is_about_a_kilowatt_at_the_zenith_and_falls_toward_the_horizon() {
+        // Meinel: 1361 · 0.7^1 = 952.7 W/m² at air mass 1.
+        assert!((clear_sky_dni(90.0) - 952.7).abs() < 1.0);
+        assert!(clear_sky_dni(10.0) < clear_sky_dni(30.0));
+        assert_eq!(clear_sky_dni(-1.0), 0.0);
+    }
 }
