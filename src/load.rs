@@ -82,6 +82,21 @@ pub struct HeightMapSummary {
     pub sample: String,
 }
 
+/// The theme set a freeform scene names (`themes.file`, relative to the scene file at
+/// `path`), loaded; `None` when the scene has no themes.
+pub fn freeform_themes(
+    path: &Path,
+    scene: &FreeformScene,
+) -> Result<Option<crate::theme::ThemeSet>> {
+    match &scene.themes {
+        Some(t) => {
+            let file = path.parent().unwrap_or(Path::new(".")).join(&t.file);
+            themes::load_themes(&file, None).map(Some)
+        }
+        None => Ok(None),
+    }
+}
+
 /// Read a freeform scene and the height maps its shape textures name (paths relative to the
 /// scene file; any height-map format, box-filtered by the grid's `downsample`), replacing each
 /// file grid by its samples.

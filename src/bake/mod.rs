@@ -4,6 +4,7 @@
 pub mod cache;
 pub mod estimate;
 pub mod plan;
+pub mod report;
 pub mod shard;
 pub mod stages;
 pub mod workspace;

@@ -177,3 +177,30 @@ pub fn gather(
     super::npy::write_npy_f32(out, &[ch as u64, n as u64], &b)?;
     Ok((ch, n))
 }
+
+/// Write one of the generated indoor scenes as `out` (OBJ, metres, y up) with its materials
+/// beside it (the same stem, `.mtl`), both atomically; returns the scene and the `.mtl` path.
+/// Precondition: `out` ends in `.obj` (`images::check_extension`).
+pub fn write_generated_scene(
+    which: crate::scene::generate::Generated,
+    out: &Path,
+) -> Result<(crate::scene::Scene, std::path::PathBuf)> {
+    let scene = crate::scene::generate::generate(which);
+    let mtl_path = out.with_extension("mtl");
+    let mtl_name = mtl_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let header = format!(
+        "{}: made by `relume-bake generate-scene {} --out FILE.obj` (metres, y up).",
+        which.name(),
+        which.name()
+    );
+    let (obj, mtl) = crate::scene::obj_writer::to_obj(&scene, &mtl_name, &header);
+    for (path, text) in [(mtl_path.as_path(), &mtl), (out, &obj)] {
+        crate::baked::images::write_atomic(path, |tmp| {
+            std::fs::write(tmp, text).map_err(|e| Error::io(path, "cannot write", e))
+        })?;
+    }
+    Ok((scene, mtl_path))
+}

@@ -21,6 +21,7 @@ pub mod mipmap;
 pub mod npy;
 pub mod patches;
 pub mod permutation;
+pub mod rasters;
 pub mod scene;
 pub mod shard;
 pub mod themes;

@@ -253,6 +253,88 @@ pub mod arg {
             far: d * 100.0,
         })
     }
+
+    /// `X,Y,Z`: three numbers.
+    pub fn triple(s: &str) -> Result<[f64; 3], String> {
+        let v: Vec<f64> = s
+            .split(',')
+            .map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}")))
+            .collect::<Result<_, _>>()?;
+        <[f64; 3]>::try_from(v).map_err(|_| format!("`{s}` is not x,y,z"))
+    }
+
+    /// A box `LO:HI`, each corner `X,Y,Z` (e.g. `-2,-2,-2:2,2,2`).
+    pub fn box3(s: &str) -> Result<([f64; 3], [f64; 3]), String> {
+        let (a, b) = s
+            .split_once(':')
+            .ok_or("expected LO:HI, e.g. -2,-2,-2:2,2,2")?;
+        Ok((triple(a)?, triple(b)?))
+    }
+
+    /// A freeform camera `EYE:TARGET:FOV` (e.g. `0,2,6:0,0,0:45`): distinct finite eye and
+    /// target, the horizontal field of view in (0, 180) degrees.
+    pub fn freeform_camera(s: &str) -> Result<crate::scene::freeform::FreeformCamera, String> {
+        let parts: Vec<&str> = s.split(':').collect();
+        if parts.len() != 3 {
+            return Err("expected EYE:TARGET:FOV, e.g. 0,2,6:0,0,0:45".into());
+        }
+        let fov: f64 = parts[2]
+            .parse()
+            .map_err(|e| format!("fov `{}`: {e}", parts[2]))?;
+        let c = crate::scene::freeform::FreeformCamera {
+            eye: triple(parts[0])?,
+            target: triple(parts[1])?,
+            fov,
+            near: None,
+            far: None,
+        };
+        if !(fov > 0.0 && fov < 180.0)
+            || c.eye == c.target
+            || !c.eye.iter().chain(&c.target).all(|v| v.is_finite())
+        {
+            return Err("need distinct finite eye and target and a fov in (0, 180)".into());
+        }
+        Ok(c)
+    }
+
+    /// A freeform scene's sun `AZ,EL` in degrees: a finite azimuth, an elevation in
+    /// [−90, 90] (f64 throughout, unlike [`sun`]).
+    pub fn freeform_sun(s: &str) -> Result<Sun, String> {
+        let (a, e) = s.split_once(',').ok_or("expected AZ,EL, e.g. 135,40")?;
+        let a: f64 = a.trim().parse().map_err(|e| format!("azimuth: {e}"))?;
+        let e: f64 = e.trim().parse().map_err(|e| format!("elevation: {e}"))?;
+        if !a.is_finite() || !(-90.0..=90.0).contains(&e) {
+            return Err("azimuth must be finite and elevation in [-90, 90]".into());
+        }
+        Ok(Sun {
+            azimuth_deg: a,
+            elevation_deg: e,
+        })
+    }
+
+    /// A finite number.
+    pub fn finite(s: &str) -> Result<f64, String> {
+        match s.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(format!("`{s}` is not a finite number")),
+        }
+    }
+
+    /// A finite number greater than 0 (the message names the text as given).
+    pub fn finite_positive(s: &str) -> Result<f64, String> {
+        match finite(s)? {
+            v if v > 0.0 => Ok(v),
+            _ => Err(format!("`{s}` must be greater than 0")),
+        }
+    }
+
+    /// A sun elevation in degrees, in [−90, 90].
+    pub fn elevation(s: &str) -> Result<f64, String> {
+        match finite(s)? {
+            v if (-90.0..=90.0).contains(&v) => Ok(v),
+            _ => Err(format!("sun elevation `{s}` is not in [-90, 90] degrees")),
+        }
+    }
 }
 
 /// serde adaptors (`deserialize_with`) over the same checks.

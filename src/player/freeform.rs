@@ -19,18 +19,13 @@ use crate::gpu::render_target::RenderTarget;
 use crate::gpu::timing::PassTimer;
 use crate::gpu::Gpu;
 use crate::render::camera::Camera;
+use crate::render::freeform_image::DEFAULT_SUN;
 use crate::render::freeform_shade::{air_placement, Shading};
 use crate::render::mesh_reference::FrameSettings;
 use crate::scene::freeform::{FreeformCamera, FreeformScene, SceneAir};
 use crate::terrain::sun::Sun;
 use glam::Vec3;
 use std::path::Path;
-
-/// The sun when neither the scene nor `--sun` gives one.
-const DEFAULT_SUN: Sun = Sun {
-    azimuth_deg: 135.0,
-    elevation_deg: 35.0,
-};
 
 /// A loaded freeform scene.
 pub struct FreeformPlayer {
@@ -58,15 +53,10 @@ impl FreeformPlayer {
             elevation_deg: s.elevation,
         });
         let mut shader = FreeformShader::new(gpu)?;
-        let themes = match &scene.themes {
-            Some(t) => {
-                let file = path.parent().unwrap_or(Path::new(".")).join(&t.file);
-                let set = crate::load::themes::load_themes(&file, None)?;
-                shader.set_themes(gpu, &set, t.projection.packed(), 0);
-                Some(set)
-            }
-            None => None,
-        };
+        let themes = crate::load::freeform_themes(path, &scene)?;
+        if let (Some(set), Some(t)) = (&themes, &scene.themes) {
+            shader.set_themes(gpu, set, t.projection.packed(), 0);
+        }
         Ok(FreeformPlayer {
             caster: FreeformCaster::new(gpu)?,
             shader,

@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod direct;
+pub mod freeform_image;
 pub mod freeform_shade;
 pub mod lights;
 pub mod mesh_reference;

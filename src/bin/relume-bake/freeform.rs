@@ -2,18 +2,15 @@
 //! by recursive multilevel ray casting. Thin: parse, check, call the library, write atomically.
 
 use clap::{Args, Subcommand, ValueEnum};
-use rayon::prelude::*;
-use relume::atmosphere::frame::air_frame;
-use relume::atmosphere::lut::Luts;
-use relume::atmosphere::twin::AtmosphereGpu;
 use relume::baked::images::{self, check_extension};
 use relume::error::exit;
-use relume::freeform::{self, Bound, Field, Lighting, Method, RmlrcParams, View};
-use relume::render::freeform_shade::{
-    air_placement, themed_albedo, through_air, FreeformAir, ThemeView,
+use relume::freeform::{Bound, Field, Method, RmlrcParams, View};
+use relume::pipeline::checks::arg;
+use relume::render::freeform_image::{
+    default_camera, render_freeform, FreeformPicture, DEFAULT_SUN,
 };
-use relume::render::tonemap::linear_to_srgb8;
 use relume::scene::freeform::FreeformCamera;
+use relume::terrain::Sun;
 use relume::{Error, Result};
 use serde_json::json;
 use std::path::PathBuf;
@@ -42,18 +39,11 @@ pub struct MeshArgs {
     #[arg(long, value_name = "E")]
     pub tolerance: f64,
     /// Box to mesh, LO:HI, e.g. -2,-2,-2:2,2,2 (surfaces are cut at its faces)
-    #[arg(long, value_name = "LO:HI", value_parser = parse_box, allow_hyphen_values = true, default_value = "-2,-2,-2:2,2,2")]
+    #[arg(long, value_name = "LO:HI", value_parser = arg::box3, allow_hyphen_values = true, default_value = "-2,-2,-2:2,2,2")]
     pub bounds: ([f64; 3], [f64; 3]),
     /// Mesh to write (.obj)
     #[arg(long, value_name = "MESH.obj")]
     pub out: PathBuf,
-}
-
-fn parse_box(s: &str) -> Result<([f64; 3], [f64; 3]), String> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or("expected LO:HI, e.g. -2,-2,-2:2,2,2")?;
-    Ok((triple(a)?, triple(b)?))
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -69,14 +59,14 @@ pub struct RenderArgs {
     /// Freeform scene (.ron)
     pub scene: PathBuf,
     /// Image size, WIDTHxHEIGHT
-    #[arg(long, value_name = "WxH", value_parser = relume::pipeline::checks::arg::wxh, default_value = "640x480")]
+    #[arg(long, value_name = "WxH", value_parser = arg::wxh, default_value = "640x480")]
     pub size: (usize, usize),
     /// Camera EYE:TARGET:FOV (overrides the scene's)
-    #[arg(long, value_name = "EYE:TARGET:FOV", value_parser = parse_camera, allow_hyphen_values = true)]
+    #[arg(long, value_name = "EYE:TARGET:FOV", value_parser = arg::freeform_camera, allow_hyphen_values = true)]
     pub camera: Option<FreeformCamera>,
     /// Sun AZ,EL in degrees (overrides the scene's)
-    #[arg(long, value_name = "AZ,EL", value_parser = parse_sun, allow_hyphen_values = true)]
-    pub sun: Option<(f64, f64)>,
+    #[arg(long, value_name = "AZ,EL", value_parser = arg::freeform_sun, allow_hyphen_values = true)]
+    pub sun: Option<Sun>,
     /// Image to write (.png, sRGB)
     #[arg(long, value_name = "IMG.png")]
     pub out: PathBuf,
@@ -107,59 +97,6 @@ pub struct RenderArgs {
     pub atmosphere: relume::atmosphere::Model,
 }
 
-fn triple(s: &str) -> Result<[f64; 3], String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}")))
-        .collect::<Result<_, _>>()?;
-    <[f64; 3]>::try_from(v).map_err(|_| format!("`{s}` is not x,y,z"))
-}
-
-fn parse_camera(s: &str) -> Result<FreeformCamera, String> {
-    let parts: Vec<&str> = s.split(':').collect();
-    if parts.len() != 3 {
-        return Err("expected EYE:TARGET:FOV, e.g. 0,2,6:0,0,0:45".into());
-    }
-    let fov: f64 = parts[2]
-        .parse()
-        .map_err(|e| format!("fov `{}`: {e}", parts[2]))?;
-    let c = FreeformCamera {
-        eye: triple(parts[0])?,
-        target: triple(parts[1])?,
-        fov,
-        near: None,
-        far: None,
-    };
-    if !(fov > 0.0 && fov < 180.0)
-        || c.eye == c.target
-        || !c.eye.iter().chain(&c.target).all(|v| v.is_finite())
-    {
-        return Err("need distinct finite eye and target and a fov in (0, 180)".into());
-    }
-    Ok(c)
-}
-
-fn parse_sun(s: &str) -> Result<(f64, f64), String> {
-    let (a, e) = s.split_once(',').ok_or("expected AZ,EL, e.g. 135,40")?;
-    let a: f64 = a.trim().parse().map_err(|e| format!("azimuth: {e}"))?;
-    let e: f64 = e.trim().parse().map_err(|e| format!("elevation: {e}"))?;
-    if !a.is_finite() || !(-90.0..=90.0).contains(&e) {
-        return Err("azimuth must be finite and elevation in [-90, 90]".into());
-    }
-    Ok((a, e))
-}
-
-/// The camera a scene is seen through when neither it nor the command line names one.
-pub fn default_camera() -> FreeformCamera {
-    FreeformCamera {
-        eye: [0.0, 2.0, 6.0],
-        target: [0.0, 0.0, 0.0],
-        fov: 45.0,
-        near: None,
-        far: None,
-    }
-}
-
 pub fn run(cmd: &FreeformCommand, json: bool, quiet: bool) -> Result<i32> {
     match cmd {
         FreeformCommand::Render(a) => render(a, json, quiet),
@@ -181,17 +118,13 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
     let scene = relume::load::freeform_scene(&a.scene)?;
     let mut field = Field::compile(&scene.shape).map_err(|e| Error::input(&a.scene, e))?;
     field.set_morph(a.morph);
-    let camera = a
-        .camera
-        .clone()
-        .or(scene.camera.clone())
-        .unwrap_or_else(default_camera);
+    let camera = a.camera.clone().or(scene.camera.clone());
     let (w, h) = (a.size.0 as u32, a.size.1 as u32);
-    let view = View::new(&camera, w, h);
-    let (az, el) = a
-        .sun
-        .or(scene.sun.map(|s| (s.azimuth, s.elevation)))
-        .unwrap_or((135.0, 45.0));
+    let view = View::new(&camera.unwrap_or_else(default_camera), w, h);
+    let scene_sun = scene.sun.map(|s| Sun {
+        azimuth_deg: s.azimuth,
+        elevation_deg: s.elevation,
+    });
     let d = RmlrcParams::default();
     let params = RmlrcParams {
         bound: a.bound.unwrap_or(d.bound),
@@ -202,82 +135,21 @@ fn render(a: &RenderArgs, json: bool, quiet: bool) -> Result<i32> {
         MethodArg::Reference => Method::Reference,
         MethodArg::Rmlrc => Method::Rmlrc(params),
     };
-    let sun = freeform::shade::sun_direction(az, el);
-    // The scene's air, by the player's twin (render::freeform_shade::through_air).
-    let atm = relume::atmosphere::Atmosphere::earth();
-    let air = scene.air.map(|sa| {
-        let (alt, sun_f64, range) =
-            air_placement(&sa, view.eye[1], view.far, sun.map(|v| v as f32), &atm);
-        let frame = air_frame(&atm, a.atmosphere, sun_f64, alt, 0.0, 1.0);
-        let luts = (a.atmosphere == relume::atmosphere::Model::Hillaire)
-            .then(|| Luts::build(&AtmosphereGpu::new(&atm, alt, sun_f64, range)));
-        (frame, (sa.metres_per_unit / 1000.0) as f32, luts)
-    });
-    let light = Lighting {
-        sun,
-        sun_colour: air.as_ref().map_or([1.0; 3], |(f, _, _)| {
-            std::array::from_fn(|k| f.sun_light[k] as f64)
-        }),
-        ambient: scene.ambient,
-        background: scene.background,
-        shadows: !a.no_shadows,
-    };
-    // The scene's thematic textures, by the player's twin (render::freeform_shade).
-    let themes = match &scene.themes {
-        Some(t) => {
-            let file = a
-                .scene
-                .parent()
-                .unwrap_or(std::path::Path::new("."))
-                .join(&t.file);
-            Some((
-                relume::load::themes::load_themes(&file, None)?,
-                t.projection.packed(),
-            ))
-        }
-        None => None,
-    };
-    let theme_view = themes.as_ref().map(|(set, (kind, projection))| ThemeView {
-        look: set.lookup(0),
-        kind: *kind,
-        projection: *projection,
-        eye: view.eye.map(|v| v as f32),
-        pixel_angle: 2.0 * view.tan_x as f32 / w as f32,
-    });
-    let albedo = |d: [f64; 3], t: f64| {
-        let tv = theme_view.as_ref().expect("only called with themes");
-        themed_albedo(tv, d.map(|v| v as f32), t as f32).map(|v| v as f64)
-    };
+    let themes = relume::load::freeform_themes(&a.scene, &scene)?;
     let t0 = Instant::now();
-    let frame = freeform::shade::render_with(
-        &field,
-        &view,
-        &method,
-        &light,
-        theme_view.is_some().then_some(&albedo as _),
-    );
-    let mut rgb = frame.rgb.clone();
-    if let Some((f, km, luts)) = &air {
-        let fa = FreeformAir {
-            frame: *f,
-            km_per_unit: *km,
-            luts: luts.as_ref(),
-        };
-        let s32 = sun.map(|v| v as f32);
-        rgb.par_iter_mut().enumerate().for_each(|(i, c)| {
-            let (d, _) = view.pixel_ray(i as u32 % w, i as u32 / w);
-            let t = frame.depth[i];
-            let t = t.is_finite().then_some(t as f32);
-            *c = through_air(*c, d.map(|v| v as f32), t, s32, &fa);
-        });
-    }
+    let picture = render_freeform(&FreeformPicture {
+        field: &field,
+        scene: &scene,
+        view: &view,
+        method: &method,
+        sun: a.sun.or(scene_sun).unwrap_or(DEFAULT_SUN),
+        shadows: !a.no_shadows,
+        atmosphere: a.atmosphere,
+        themes: themes.as_ref(),
+    });
     let seconds = t0.elapsed().as_secs_f64();
-    let mut img = image::RgbaImage::new(w, h);
-    for (px, rgb) in img.pixels_mut().zip(&rgb) {
-        let [r, g, b] = rgb.map(linear_to_srgb8);
-        *px = image::Rgba([r, g, b, 255]);
-    }
-    images::write_png_rgba(&a.out, &img)?;
+    images::write_png_rgba(&a.out, &picture.to_rgba8())?;
+    let frame = &picture.frame;
     if let Some(d) = &a.depth {
         let depth: Vec<f32> = frame.depth.iter().map(|&t| t as f32).collect();
         images::write_exr_gray(d, w as usize, h as usize, &depth)?;

@@ -1,25 +1,23 @@
 //! `horizon` (horizon maps and the sky-view factor) and `sunlight` (hours of direct sun over a
 //! day). Thin: load, call the library, write images atomically.
 
-use crate::sun_args::place_of;
 use crate::terrain::{load_map, print_json, MapArgs};
 use crate::ui::Ui;
 use clap::Args;
-use relume::baked::images::{self, check_extension};
+use relume::baked::images::check_extension;
+use relume::baked::rasters;
 use relume::error::{exit, Error};
-use relume::heightmap::georef::write_geotiff_f32;
-use relume::heightmap::{HeightMap, HeightMapInfo};
 use relume::pipeline::checks::arg;
 use relume::pipeline::knobs::{HorizonMapsKnobs, DEFAULT_HORIZON_DIRECTIONS};
 use relume::progress::Progress;
-use relume::terrain::horizon::map::{decode, HorizonMap, HorizonSettings};
-use relume::terrain::horizon::sunlight::{day_steps, sunlight};
-use relume::terrain::sun::solar::Instant;
+use relume::terrain::horizon::map::{HorizonMap, HorizonSettings};
+use relume::terrain::horizon::sunlight::{
+    day_steps, daylight_hours, mean_hours, parse_day, parse_step, sunlight,
+};
+use relume::terrain::sun::spec::place_of;
 use relume::Result;
 use serde_json::json;
-use std::path::{Path, PathBuf};
-
-const NODATA: f64 = -9999.0;
+use std::path::PathBuf;
 
 /// The horizon map's settings from the flags (checked by their parsers), else the stage's
 /// defaults.
@@ -79,25 +77,6 @@ pub struct SunlightArgs {
     pub insolation: Option<PathBuf>,
 }
 
-/// Write a float raster as GeoTIFF (keeping the input's georeference, no-data −9999) or EXR.
-fn write_raster(path: &Path, map: &HeightMap, info: &HeightMapInfo, v: &[f32]) -> Result<()> {
-    if images::is_exr(path) {
-        return images::write_exr_gray(path, map.width, map.height, v);
-    }
-    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
-    let v: Vec<f32> = (0..v.len())
-        .map(|i| if nodata(i) { NODATA as f32 } else { v[i] })
-        .collect();
-    write_geotiff_f32(
-        path,
-        map.width,
-        map.height,
-        &v,
-        info.georef.as_ref(),
-        Some(NODATA),
-    )
-}
-
 /// `relume-bake horizon`.
 pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
     if let Some(p) = &args.sky_view {
@@ -118,15 +97,10 @@ pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i
     let seconds = t0.elapsed().as_secs_f64();
     ui.finish();
     if let Some(p) = &args.sky_view {
-        write_raster(p, &map, &info, &hm.sky_view())?;
+        rasters::write_float_raster(p, &map, &info, &hm.sky_view())?;
     }
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create directory", e))?;
-        for (d, plane) in hm.directions.iter().zip(&hm.angles) {
-            let v: Vec<f32> = plane.iter().map(|&q| decode(q) as f32).collect();
-            let p = dir.join(format!("horizon_{:07.3}.tif", d.azimuth_deg));
-            write_raster(&p, &map, &info, &v)?;
-        }
+        rasters::write_horizon_planes(dir, &map, &info, &hm)?;
     }
     if json {
         print_json(&json!({
@@ -148,31 +122,6 @@ pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i
     Ok(exit::OK)
 }
 
-/// Seconds from `30`, `30s`, `10m`, `1h`.
-fn parse_step(text: &str) -> Result<f64> {
-    let t = text.trim();
-    let (num, unit) = match t.char_indices().find(|(_, c)| c.is_ascii_alphabetic()) {
-        Some((i, _)) => (&t[..i], &t[i..]),
-        None => (t, "s"),
-    };
-    let k = match unit {
-        "s" => 1.0,
-        "m" | "min" => 60.0,
-        "h" => 3600.0,
-        _ => {
-            return Err(Error::knob(format!(
-                "--step `{text}`: unknown unit `{unit}` (use s, m or h, e.g. 10m)"
-            )))
-        }
-    };
-    match num.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * k),
-        _ => Err(Error::knob(format!(
-            "--step `{text}`: not a positive duration (e.g. 10m)"
-        ))),
-    }
-}
-
 /// `relume-bake sunlight`.
 pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
     check_extension(&args.out, &["tif", "tiff", "exr"])?;
@@ -181,11 +130,7 @@ pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Re
     }
     let step = parse_step(&args.step)?;
     let settings = horizon_settings(args.directions, args.planet_radius);
-    let date = if args.date.len() == 10 {
-        Instant::parse(&format!("{}T00:00:00Z", args.date))?
-    } else {
-        Instant::parse(&args.date)?
-    };
+    let date = parse_day(&args.date)?;
     if args.lat.is_some() != args.lon.is_some() {
         return Err(Error::knob(
             "give both --lat and --lon, or neither (the GeoTIFF's centre)",
@@ -207,21 +152,12 @@ pub fn sunlight_cmd(args: &SunlightArgs, ui: &Ui, quiet: bool, json: bool) -> Re
     let (hours, energy) = sunlight(&map, &hm, &steps, args.insolation.is_some());
     ui.finish();
     let day_s = t1.elapsed().as_secs_f64();
-    write_raster(&args.out, &map, &info, &hours)?;
+    rasters::write_float_raster(&args.out, &map, &info, &hours)?;
     if let (Some(p), Some(e)) = (&args.insolation, &energy) {
-        write_raster(p, &map, &info, e)?;
+        rasters::write_float_raster(p, &map, &info, e)?;
     }
-    let daylight: f64 = steps
-        .iter()
-        .filter(|s| s.sun.elevation_deg > 0.0)
-        .map(|s| s.hours)
-        .sum();
-    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
-    let valid: Vec<f64> = (0..hours.len())
-        .filter(|&i| !nodata(i))
-        .map(|i| hours[i] as f64)
-        .collect();
-    let mean = valid.iter().sum::<f64>() / valid.len().max(1) as f64;
+    let daylight = daylight_hours(&steps);
+    let mean = mean_hours(&hours, &info.nodata_mask);
     if json {
         print_json(&json!({
                 "input": args.map.input.display().to_string(),

@@ -13,6 +13,7 @@ mod theme;
 mod ui;
 
 use clap::{Args, Parser, Subcommand};
+use relume::bake::report;
 use relume::error::exit;
 use relume::heightmap::{HeightMapOptions, NoDataPolicy};
 use relume::load::{load_any, summarize_heightmap, summarize_scene, LoadedInput};
@@ -198,56 +199,6 @@ fn main() {
     std::process::exit(code);
 }
 
-/// `.relume-cache` in the output's parent directory.
-fn default_cache(out: &Path) -> PathBuf {
-    match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.join(".relume-cache"),
-        _ => PathBuf::from(".relume-cache"),
-    }
-}
-
-/// What `run` tells people: where the bake went, and which stages were reused or skipped.
-fn bake_summary(report: &relume::bake::BakeReport) -> String {
-    let bytes: u64 = report.files.iter().map(|f| f.bytes).sum();
-    let size = relume::limits::human_bytes(bytes);
-    if report.up_to_date {
-        return format!(
-            "up to date: {} already holds this bake ({} files, {size}, all verified); nothing to do\n",
-            report.output.display(),
-            report.files.len() + 1
-        );
-    }
-    let mut s = format!(
-        "baked {} ({} files, {size})\n",
-        report.output.display(),
-        report.files.len() + 1
-    );
-    let cached: Vec<&str> = report
-        .stages
-        .iter()
-        .filter(|t| t.cached)
-        .map(|t| t.stage.as_str())
-        .collect();
-    if !cached.is_empty() {
-        let ran: Vec<&str> = report
-            .stages
-            .iter()
-            .filter(|t| !t.cached && t.stage != "load")
-            .map(|t| t.stage.as_str())
-            .collect();
-        s += &format!(
-            "reused from the stage cache: {}; ran: {}\n",
-            cached.join(", "),
-            if ran.is_empty() {
-                "nothing".to_string()
-            } else {
-                ran.join(", ")
-            }
-        );
-    }
-    s
-}
-
 fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
     let json = cli.global.json;
     match &cli.command {
@@ -268,7 +219,7 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             }
             opts.force = *force;
             if !no_cache {
-                opts.cache = Some(cache.clone().unwrap_or_else(|| default_cache(&out)));
+                opts.cache = Some(cache.clone().unwrap_or_else(|| report::default_cache(&out)));
             }
             let (sharding, note) = shard.sharding(&out)?;
             let sharded = !matches!(sharding, relume::bake::Sharding::Whole);
@@ -280,10 +231,10 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             if json {
                 print_json(&report);
             } else if !cli.global.quiet {
-                match scale::summary(&report, &out) {
+                match report::shard_summary(&report, &out) {
                     Some(s) => eprint!("{s}"),
-                    None if sharded => eprint!("{}", scale::nothing_to_shard(&out)),
-                    None => eprint!("{}", bake_summary(&report)),
+                    None if sharded => eprint!("{}", report::nothing_to_shard(&out)),
+                    None => eprint!("{}", report::bake_summary(&report)),
                 }
             }
             Ok(exit::OK)
@@ -295,7 +246,11 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             if let Some(mm) = m.max_memory {
                 opts.max_memory = mm;
             }
-            opts.cache = Some(m.cache.clone().unwrap_or_else(|| default_cache(&m.output)));
+            opts.cache = Some(
+                m.cache
+                    .clone()
+                    .unwrap_or_else(|| report::default_cache(&m.output)),
+            );
             opts.sharding = relume::bake::Sharding::Merge {
                 dirs: m.shard_dirs.clone(),
             };
@@ -303,9 +258,9 @@ fn dispatch(cli: &Cli, ui: &Ui) -> Result<i32> {
             if json {
                 print_json(&report);
             } else if !cli.global.quiet {
-                match scale::summary(&report, &m.output) {
+                match report::shard_summary(&report, &m.output) {
                     Some(s) => eprint!("{s}"),
-                    None => eprint!("{}", bake_summary(&report)),
+                    None => eprint!("{}", report::bake_summary(&report)),
                 }
             }
             Ok(exit::OK)
@@ -395,18 +350,7 @@ fn print_stage_report(report: &relume::bake::BakeReport, dir: &Path, json: bool,
     if json {
         print_json(report);
     } else if !quiet {
-        for s in &report.stages {
-            eprintln!(
-                "ran {} on {} in {:.2} s → {}",
-                s.stage,
-                dir.display(),
-                s.seconds,
-                s.outputs.join(", ")
-            );
-            for (k, v) in &s.report {
-                eprintln!("  {k:<28} {v}");
-            }
-        }
+        eprint!("{}", report::stage_lines(report, dir));
     }
 }
 

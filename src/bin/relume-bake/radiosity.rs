@@ -16,7 +16,7 @@ use relume::radiosity::patches::adaptive::AdaptiveParams;
 use relume::radiosity::patches::voxelize::Resolution;
 use relume::radiosity::transport::{Bounces, Power};
 use relume::render::mesh_reference::FrameSettings;
-use relume::scene::generate::{generate, Generated};
+use relume::scene::generate::Generated;
 use relume::scene::light_spec::parse_light;
 use relume::scene::Light;
 use relume::Result;
@@ -273,23 +273,7 @@ pub fn run(cmd: &Command, json: bool, quiet: bool, ui: &crate::ui::Ui) -> Result
 
 fn generate_scene(which: Generated, out: &Path, json: bool, quiet: bool) -> Result<i32> {
     relume::baked::images::check_extension(out, &["obj"])?;
-    let scene = generate(which);
-    let mtl_path = out.with_extension("mtl");
-    let mtl_name = mtl_path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let header = format!(
-        "{}: made by `relume-bake generate-scene {} --out FILE.obj` (metres, y up).",
-        which.name(),
-        which.name()
-    );
-    let (obj, mtl) = relume::scene::obj_writer::to_obj(&scene, &mtl_name, &header);
-    for (path, text) in [(mtl_path.as_path(), &mtl), (out, &obj)] {
-        relume::baked::images::write_atomic(path, |tmp| {
-            std::fs::write(tmp, text).map_err(|e| relume::error::Error::io(path, "cannot write", e))
-        })?;
-    }
+    let (scene, mtl_path) = relume::baked::export::write_generated_scene(which, out)?;
     if json {
         println!(
             "{}",

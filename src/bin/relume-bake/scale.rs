@@ -1,9 +1,9 @@
-//! Scale-out on the command line: `run --shard I/N` (or the scheduler's environment), `merge`,
-//! and what they tell people (docs/scale-out.md).
+//! Scale-out on the command line: `run --shard I/N` (or the scheduler's environment) and
+//! `merge` (docs/scale-out.md); what they tell people is `relume::bake::report`'s.
 
 use clap::Args;
-use relume::bake::{shard, BakeReport, Sharding};
-use relume::error::Error;
+use relume::bake::report::ShardRequest;
+use relume::bake::{shard, Sharding};
 use relume::Result;
 use std::path::{Path, PathBuf};
 
@@ -28,38 +28,16 @@ pub struct ShardArgs {
     pub no_shard: bool,
 }
 
-/// `OUT.shards` beside the output.
-pub fn default_shard_dir(out: &Path) -> PathBuf {
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "bake".into());
-    out.with_file_name(format!("{name}.shards"))
-}
-
 impl ShardArgs {
     /// The sharding of this `run`, and a note when the environment chose it.
     pub fn sharding(&self, out: &Path) -> Result<(Sharding, Option<String>)> {
-        let dir = self
-            .shard_dir
-            .clone()
-            .unwrap_or_else(|| default_shard_dir(out));
-        if self.no_shard {
-            return Ok((Sharding::Whole, None));
-        }
-        if let Some((index, count)) = self.shard {
-            return Ok((Sharding::Shard { index, count, dir }, None));
-        }
-        let env = |k: &str| std::env::var(k).ok();
-        match shard::shard_from_env(self.shards.map(|n| n as usize), env).map_err(Error::knob)? {
-            Some((index, count, source)) => Ok((
-                Sharding::Shard { index, count, dir },
-                Some(format!(
-                    "shard {index}/{count} from {source} (--no-shard bakes the whole pipeline)"
-                )),
-            )),
-            None => Ok((Sharding::Whole, None)),
-        }
+        let request = ShardRequest {
+            shard: self.shard,
+            shards: self.shards,
+            shard_dir: self.shard_dir.clone(),
+            no_shard: self.no_shard,
+        };
+        request.sharding(out, |k| std::env::var(k).ok())
     }
 }
 
@@ -77,46 +55,4 @@ pub struct MergeArgs {
     /// The stage cache the shards used (default: .relume-cache beside the output)
     #[arg(long, value_name = "DIR")]
     pub cache: Option<PathBuf>,
-}
-
-/// What a sharded `run` or a `merge` tells people, or `None` for a whole bake.
-pub fn summary(report: &BakeReport, out: &Path) -> Option<String> {
-    if let Some(s) = &report.shard {
-        return Some(format!(
-            "{} shard {}/{} of `{}` ({}): {}\n",
-            if s.reused {
-                "already there, verified:"
-            } else {
-                "wrote"
-            },
-            s.index,
-            s.count,
-            s.stage,
-            s.part,
-            s.path.display()
-        ));
-    }
-    if let Some(stage) = &report.needs_shards {
-        let merged: Vec<&str> = report
-            .stages
-            .iter()
-            .filter(|t| t.stage != "load")
-            .map(|t| t.stage.as_str())
-            .collect();
-        return Some(format!(
-            "merged up to `{}`, kept in the stage cache; `{stage}` needs its shards next: run \
-             `relume-bake run PIPELINE --out {} --shard I/N` for every I, then merge again\n",
-            merged.last().copied().unwrap_or("load"),
-            out.display()
-        ));
-    }
-    None
-}
-
-/// A sharded `run` that found every shardable stage in the cache.
-pub fn nothing_to_shard(out: &Path) -> String {
-    format!(
-        "nothing to shard: every expensive stage of this bake is in the stage cache; run `relume-bake merge {} SHARD_DIR` to finish it\n",
-        out.display()
-    )
 }

@@ -5,6 +5,7 @@
 use crate::ui::Ui;
 use clap::{Args, Subcommand};
 use relume::error::exit;
+use relume::pipeline::checks::arg;
 use relume::study::{
     self, atmosphere, compression, inputs, radiosity, radiosity_objects, report, terrain, Study,
 };
@@ -139,22 +140,22 @@ pub struct TerrainArgs {
     #[arg(long, value_name = "FILE")]
     pub pipeline: Option<PathBuf>,
     /// Metres per texel (overrides the file / pipeline)
-    #[arg(long, value_name = "M", value_parser = positive)]
+    #[arg(long, value_name = "M", value_parser = arg::finite_positive)]
     pub cell_size: Option<f64>,
     /// Metres per file unit (overrides the pipeline)
-    #[arg(long, value_name = "S", value_parser = positive)]
+    #[arg(long, value_name = "S", value_parser = arg::finite_positive)]
     pub height_scale: Option<f64>,
     /// Map sizes (longer side, texels), e.g. 1024,2048,4096
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=65_536))]
     pub sizes: Option<Vec<u32>>,
     /// Sun elevations in degrees, e.g. 5,15,30,60
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = elevation, allow_hyphen_values = true)]
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = arg::elevation, allow_hyphen_values = true)]
     pub elevations: Option<Vec<f64>>,
     /// Sun azimuth, degrees clockwise from north
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true, value_parser = finite)]
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true, value_parser = arg::finite)]
     pub azimuth: Option<f64>,
     /// Sun elevations of the soft-shadow sweep in degrees, e.g. 2,5,10
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = elevation, allow_hyphen_values = true)]
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = arg::elevation, allow_hyphen_values = true)]
     pub soft_elevations: Option<Vec<f64>>,
     /// Rows of each map the soft-shadow sweep times (evenly spaced; the exhaustive reference
     /// is slow at low sun)
@@ -167,27 +168,6 @@ pub struct TerrainArgs {
     /// 0,4,16 (0 = as many as the track needs; default 0)
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub dp_intervals: Option<Vec<u32>>,
-}
-
-fn finite(s: &str) -> std::result::Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(format!("`{s}` is not a finite number")),
-    }
-}
-
-fn positive(s: &str) -> std::result::Result<f64, String> {
-    match finite(s)? {
-        v if v > 0.0 => Ok(v),
-        _ => Err(format!("`{s}` must be greater than 0")),
-    }
-}
-
-fn elevation(s: &str) -> std::result::Result<f64, String> {
-    match finite(s)? {
-        v if (-90.0..=90.0).contains(&v) => Ok(v),
-        _ => Err(format!("sun elevation `{s}` is not in [-90, 90] degrees")),
-    }
 }
 
 fn source(s: &SceneSource) -> inputs::SceneSource {

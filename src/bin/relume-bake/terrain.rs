@@ -5,14 +5,14 @@ use crate::sun_args::SunArgs;
 use crate::ui::Ui;
 use clap::{Args, ValueEnum};
 use relume::baked::images::{self, check_extension};
+use relume::baked::rasters;
 use relume::error::exit;
-use relume::heightmap::georef::{write_geotiff_f32, write_geotiff_u8};
 use relume::heightmap::{HeightMap, HeightMapInfo};
 use relume::progress::Progress;
-use relume::render::tonemap::linear_to_srgb8;
 use relume::terrain::generate::{generate, quantise_u16, Shape};
 use relume::terrain::hard::relief::{self, HardMethod};
-use relume::terrain::soft::{soft_shadow_map, SoftMethod, SoftShadowParams};
+use relume::terrain::soft::model::SUN_RADIUS_DEG;
+use relume::terrain::soft::{lit_summary, soft_shadow_map, SoftMethod, SoftShadowParams};
 use relume::terrain::Sun;
 use relume::Result;
 use serde_json::json;
@@ -87,12 +87,12 @@ impl ReliefArgs {
 
     /// Write the relief when asked for; `shadow` is the shadowed fraction per texel.
     fn write(&self, map: &HeightMap, sun: &Sun, shadow: &[f32]) -> Result<()> {
-        if let Some(path) = &self.shaded {
-            let relief = relief::shaded_relief(map, sun, shadow, self.k_dark, self.k_bright);
-            let px = relief.into_iter().map(linear_to_srgb8).collect();
-            images::write_png_gray8(path, map.width, map.height, px)?;
+        match &self.shaded {
+            Some(p) => {
+                rasters::write_shaded_relief(p, map, sun, shadow, self.k_dark, self.k_bright)
+            }
+            None => Ok(()),
         }
-        Ok(())
     }
 
     fn json(&self) -> Option<String> {
@@ -133,7 +133,7 @@ pub struct SoftShadowArgs {
     #[command(flatten)]
     pub sun: SunArgs,
     /// Angular radius of the sun disc in degrees (the Sun: 0.2666)
-    #[arg(long, value_name = "DEG", default_value_t = 0.2666)]
+    #[arg(long, value_name = "DEG", default_value_t = SUN_RADIUS_DEG)]
     pub sun_radius: f64,
     /// Planet radius in metres for curved terrain (Moon 1737400, Earth 6371000); default flat
     #[arg(long, value_name = "M")]
@@ -164,7 +164,7 @@ pub struct SoftShadowArgs {
 
 /// `relume-bake softshadow`.
 pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
-    args.sun.check()?;
+    args.sun.spec().check()?;
     check_extension(&args.out, &["png", "exr", "tif", "tiff"])?;
     args.relief.check()?;
     let method = match args.method {
@@ -185,40 +185,16 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
     ui.begin("load", 0);
     let (map, info) = load_map(&args.map)?;
     ui.finish();
-    let (sun, sun_json) = args.sun.resolve(&map, &info)?;
+    let (sun, sun_json) = args.sun.spec().resolve(&map, &info)?;
     let t0 = Instant::now();
     let lit = soft_shadow_map(&map, &sun, &params, None, ui)?;
     let seconds = t0.elapsed().as_secs_f64();
-    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
-    if is_tiff(&args.out) {
-        let v: Vec<f32> = (0..lit.len())
-            .map(|i| if nodata(i) { -1.0 } else { lit[i] })
-            .collect();
-        write_geotiff_f32(
-            &args.out,
-            map.width,
-            map.height,
-            &v,
-            info.georef.as_ref(),
-            Some(-1.0),
-        )?;
-    } else if images::is_exr(&args.out) {
-        images::write_exr_gray(&args.out, map.width, map.height, &lit)?;
-    } else {
-        let px = lit
-            .iter()
-            .map(|&l| (l.clamp(0.0, 1.0) * 65535.0).round() as u16)
-            .collect();
-        images::write_png_gray16(&args.out, map.width, map.height, px)?;
-    }
+    rasters::write_lit_fraction(&args.out, &map, &info, &lit)?;
     if args.relief.shaded.is_some() {
         let shadow: Vec<f32> = lit.iter().map(|l| 1.0 - l).collect();
         args.relief.write(&map, &sun, &shadow)?;
     }
-    let valid = || (0..lit.len()).filter(|&i| !nodata(i)).map(|i| lit[i]);
-    let n = valid().count().max(1) as f64;
-    let mean = valid().map(|l| l as f64).sum::<f64>() / n;
-    let penumbra = valid().filter(|&l| l > 0.0 && l < 1.0).count() as f64 / n;
+    let (mean, penumbra) = lit_summary(&lit, &info.nodata_mask);
     let mpix = lit.len() as f64 / seconds.max(1e-9) / 1e6;
     if json {
         print_json(&json!({
@@ -255,61 +231,29 @@ pub fn load_map(args: &MapArgs) -> Result<(HeightMap, HeightMapInfo)> {
     relume::load::heightmap_input_with_info(&args.input, args.cell_size, args.height_scale)
 }
 
-fn is_tiff(path: &std::path::Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("tif") || e.eq_ignore_ascii_case("tiff"))
-}
-
 pub fn print_json(v: &serde_json::Value) {
     println!("{}", serde_json::to_string_pretty(v).expect("json"));
 }
 
 /// `relume-bake shadow`.
 pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32> {
-    args.sun.check()?;
+    args.sun.spec().check()?;
     check_extension(&args.out, &["png", "tif", "tiff"])?;
     args.relief.check()?;
     ui.begin("load", 0);
     let (map, info) = load_map(&args.map)?;
     ui.finish();
-    let (sun, sun_json) = args.sun.resolve(&map, &info)?;
+    let (sun, sun_json) = args.sun.spec().resolve(&map, &info)?;
     let method = args.method;
     let t0 = Instant::now();
     let mask = relief::shadow_mask(&map, &sun, method, None, ui);
     let seconds = t0.elapsed().as_secs_f64();
-    let nodata = |i: usize| info.nodata_mask.get(i).copied().unwrap_or(false);
-    let valid = (0..mask.len()).filter(|&i| !nodata(i)).count().max(1);
-    let shadowed = (0..mask.len()).filter(|&i| mask[i] && !nodata(i)).count();
-    if is_tiff(&args.out) {
-        let px: Vec<u8> = (0..mask.len())
-            .map(|i| {
-                if nodata(i) {
-                    128
-                } else if mask[i] {
-                    0
-                } else {
-                    255
-                }
-            })
-            .collect();
-        write_geotiff_u8(
-            &args.out,
-            map.width,
-            map.height,
-            &px,
-            info.georef.as_ref(),
-            Some(128),
-        )?;
-    } else {
-        let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
-        images::write_png_gray8(&args.out, map.width, map.height, pixels)?;
-    }
+    rasters::write_shadow_mask(&args.out, &map, &info, &mask)?;
     if args.relief.shaded.is_some() {
         let shadow: Vec<f32> = mask.iter().map(|&s| s as u8 as f32).collect();
         args.relief.write(&map, &sun, &shadow)?;
     }
-    let fraction = shadowed as f64 / valid as f64;
+    let fraction = relief::shadowed_fraction(&mask, &info.nodata_mask);
     let mpix = mask.len() as f64 / seconds.max(1e-9) / 1e6;
     if json {
         print_json(&json!({

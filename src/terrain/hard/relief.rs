@@ -137,3 +137,12 @@ pub fn shaded_relief(
         .map(|(l, &s)| l * (1.0 - (1.0 - k) * s))
         .collect()
 }
+
+/// The fraction of shadowed texels of `mask` among those `nodata` (one flag per texel, or empty
+/// for none) does not mark; 0 when none is valid.
+pub fn shadowed_fraction(mask: &[bool], nodata: &[bool]) -> f64 {
+    let nd = |i: usize| nodata.get(i).copied().unwrap_or(false);
+    let valid = (0..mask.len()).filter(|&i| !nd(i)).count().max(1);
+    let shadowed = (0..mask.len()).filter(|&i| mask[i] && !nd(i)).count();
+    shadowed as f64 / valid as f64
+}

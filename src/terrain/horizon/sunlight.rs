@@ -168,6 +168,61 @@ pub fn normals(map: &HeightMap) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// Seconds from a duration as `--step` spells it: `30`, `30s`, `10m` (or `min`), `1h`; refuses
+/// unknown units and anything not a positive finite number.
+pub fn parse_step(text: &str) -> Result<f64> {
+    let t = text.trim();
+    let (num, unit) = match t.char_indices().find(|(_, c)| c.is_ascii_alphabetic()) {
+        Some((i, _)) => (&t[..i], &t[i..]),
+        None => (t, "s"),
+    };
+    let k = match unit {
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => {
+            return Err(Error::knob(format!(
+                "--step `{text}`: unknown unit `{unit}` (use s, m or h, e.g. 10m)"
+            )))
+        }
+    };
+    match num.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * k),
+        _ => Err(Error::knob(format!(
+            "--step `{text}`: not a positive duration (e.g. 10m)"
+        ))),
+    }
+}
+
+/// The instant a day is given by: a bare date (`2026-06-21`, taken at 00:00 UTC) or any instant
+/// of it with a zone (ISO 8601).
+pub fn parse_day(text: &str) -> Result<Instant> {
+    if text.len() == 10 {
+        Instant::parse(&format!("{text}T00:00:00Z"))
+    } else {
+        Instant::parse(text)
+    }
+}
+
+/// Hours of the day with the sun above the horizon: the lengths of the steps whose sun is up.
+pub fn daylight_hours(steps: &[Step]) -> f64 {
+    steps
+        .iter()
+        .filter(|s| s.sun.elevation_deg > 0.0)
+        .map(|s| s.hours)
+        .sum()
+}
+
+/// The mean of `hours` over the texels `nodata` (one flag per texel, or empty for none) does
+/// not mark; 0 when none is valid.
+pub fn mean_hours(hours: &[f32], nodata: &[bool]) -> f64 {
+    let valid: Vec<f64> = (0..hours.len())
+        .filter(|&i| !nodata.get(i).copied().unwrap_or(false))
+        .map(|i| hours[i] as f64)
+        .collect();
+    valid.iter().sum::<f64>() / valid.len().max(1) as f64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

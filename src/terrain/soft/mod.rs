@@ -206,3 +206,18 @@ pub fn soft_shadow_map(
     progress.finish();
     Ok(out)
 }
+
+/// The mean lit fraction and the fraction of texels in penumbra (lit strictly between 0 and 1)
+/// over the texels of `lit` that `nodata` (one flag per texel, or empty for none) does not mark.
+/// Both are 0 when no texel is valid.
+pub fn lit_summary(lit: &[f32], nodata: &[bool]) -> (f64, f64) {
+    let valid = || {
+        (0..lit.len())
+            .filter(|&i| !nodata.get(i).copied().unwrap_or(false))
+            .map(|i| lit[i])
+    };
+    let n = valid().count().max(1) as f64;
+    let mean = valid().map(|l| l as f64).sum::<f64>() / n;
+    let penumbra = valid().filter(|&l| l > 0.0 && l < 1.0).count() as f64 / n;
+    (mean, penumbra)
+}

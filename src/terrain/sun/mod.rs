@@ -8,6 +8,7 @@
 //! `rise_per_t` metres per unit of t (tan el × world metres per unit of t).
 
 pub mod solar;
+pub mod spec;
 
 use crate::error::{Error, Result};
 

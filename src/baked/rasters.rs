@@ -1,0 +1,158 @@
+//! The rasters the terrain commands write over a height map's grid (`relume-bake shadow`,
+//! `softshadow`, `horizon`, `sunlight`): shadow masks, lit fractions, float rasters, one
+//! horizon-angle plane per azimuth and the shaded relief. A `.tif` is a GeoTIFF with the input's
+//! georeference, the input's no-data texels written as the raster's no-data value; the other
+//! formats go through `baked::images` (atomic).
+
+use crate::baked::images::{self, is_exr};
+use crate::error::{Error, Result};
+use crate::heightmap::georef::{write_geotiff_f32, write_geotiff_u8};
+use crate::heightmap::{HeightMap, HeightMapInfo};
+use crate::render::tonemap::linear_to_srgb8;
+use crate::terrain::hard::relief;
+use crate::terrain::horizon::map::{decode, HorizonMap};
+use crate::terrain::Sun;
+use std::path::Path;
+
+/// The no-data value of float GeoTIFF rasters (horizon angles, sky view, sun hours).
+pub const NODATA: f64 = -9999.0;
+
+/// Whether `path` ends in `.tif` or `.tiff` (any case).
+pub fn is_tiff(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("tif") || e.eq_ignore_ascii_case("tiff"))
+}
+
+/// Whether texel `i` of the loaded map is no-data (false where the map has no mask).
+pub fn is_nodata(info: &HeightMapInfo, i: usize) -> bool {
+    info.nodata_mask.get(i).copied().unwrap_or(false)
+}
+
+/// Write a hard-shadow mask (`true` = in shadow, one per texel of `map`): a GeoTIFF u8 (255 lit,
+/// 0 shadow, 128 no-data) or a PNG (255 lit, 0 shadow).
+pub fn write_shadow_mask(
+    path: &Path,
+    map: &HeightMap,
+    info: &HeightMapInfo,
+    mask: &[bool],
+) -> Result<()> {
+    if is_tiff(path) {
+        let px: Vec<u8> = (0..mask.len())
+            .map(|i| {
+                if is_nodata(info, i) {
+                    128
+                } else if mask[i] {
+                    0
+                } else {
+                    255
+                }
+            })
+            .collect();
+        write_geotiff_u8(
+            path,
+            map.width,
+            map.height,
+            &px,
+            info.georef.as_ref(),
+            Some(128),
+        )
+    } else {
+        let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
+        images::write_png_gray8(path, map.width, map.height, pixels)
+    }
+}
+
+/// Write a lit fraction in [0, 1] per texel of `map`: a GeoTIFF f32 (no-data −1), an EXR (f32)
+/// or a 16-bit PNG (65535 = fully lit).
+pub fn write_lit_fraction(
+    path: &Path,
+    map: &HeightMap,
+    info: &HeightMapInfo,
+    lit: &[f32],
+) -> Result<()> {
+    if is_tiff(path) {
+        let v: Vec<f32> = (0..lit.len())
+            .map(|i| if is_nodata(info, i) { -1.0 } else { lit[i] })
+            .collect();
+        write_geotiff_f32(
+            path,
+            map.width,
+            map.height,
+            &v,
+            info.georef.as_ref(),
+            Some(-1.0),
+        )
+    } else if is_exr(path) {
+        images::write_exr_gray(path, map.width, map.height, lit)
+    } else {
+        let px = lit
+            .iter()
+            .map(|&l| (l.clamp(0.0, 1.0) * 65535.0).round() as u16)
+            .collect();
+        images::write_png_gray16(path, map.width, map.height, px)
+    }
+}
+
+/// Write a float raster over `map` (one value per texel): an EXR as is, else a GeoTIFF f32 with
+/// the input's georeference and no-data texels as [`NODATA`].
+pub fn write_float_raster(
+    path: &Path,
+    map: &HeightMap,
+    info: &HeightMapInfo,
+    v: &[f32],
+) -> Result<()> {
+    if is_exr(path) {
+        return images::write_exr_gray(path, map.width, map.height, v);
+    }
+    let v: Vec<f32> = (0..v.len())
+        .map(|i| {
+            if is_nodata(info, i) {
+                NODATA as f32
+            } else {
+                v[i]
+            }
+        })
+        .collect();
+    write_geotiff_f32(
+        path,
+        map.width,
+        map.height,
+        &v,
+        info.georef.as_ref(),
+        Some(NODATA),
+    )
+}
+
+/// Write one horizon-angle GeoTIFF per azimuth of `hm` (degrees, f32) into `dir` (created if
+/// missing), named `horizon_AAA.AAA.tif` by the direction's exact azimuth.
+pub fn write_horizon_planes(
+    dir: &Path,
+    map: &HeightMap,
+    info: &HeightMapInfo,
+    hm: &HorizonMap,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create directory", e))?;
+    for (d, plane) in hm.directions.iter().zip(&hm.angles) {
+        let v: Vec<f32> = plane.iter().map(|&q| decode(q) as f32).collect();
+        let p = dir.join(format!("horizon_{:07.3}.tif", d.azimuth_deg));
+        write_float_raster(&p, map, info, &v)?;
+    }
+    Ok(())
+}
+
+/// Write the shaded relief of `map` (8-bit sRGB PNG): Lambert × (k_shadow + (1 − k_shadow)·lit),
+/// `shadow` the shadowed fraction per texel (`terrain::hard::relief::shaded_relief`; the k's
+/// checked by `relief::check_k`).
+pub fn write_shaded_relief(
+    path: &Path,
+    map: &HeightMap,
+    sun: &Sun,
+    shadow: &[f32],
+    k_dark: f64,
+    k_bright: f64,
+) -> Result<()> {
+    let relief = relief::shaded_relief(map, sun, shadow, k_dark, k_bright);
+    let px = relief.into_iter().map(linear_to_srgb8).collect();
+    images::write_png_gray8(path, map.width, map.height, px)
+}
