@@ -265,6 +265,18 @@ pub struct ThemesKnobs {
 /// The default number of horizon azimuths.
 pub const DEFAULT_HORIZON_DIRECTIONS: u32 = 64;
 
+/// Shaded relief (`shadow --shaded`): the shadow brightness with the sun on the horizon and at
+/// the zenith, k_dark and k_bright of the relief-shadow paper's eq. 4 (docs/algorithms.md §4).
+pub const DEFAULT_K_DARK: f64 = 0.2;
+pub const DEFAULT_K_BRIGHT: f64 = 0.6;
+
+/// Soft shadows (`softshadow`): samples along the track of the uniform method.
+pub const DEFAULT_SOFT_STEPS: u32 = 100;
+/// Soft shadows: the mipmap level the dynamic programme starts from (−1 = texels).
+pub const DEFAULT_SOFT_START_LEVEL: i32 = 4;
+/// Soft shadows: the dynamic programme's intervals along the track (0 = as many as it needs).
+pub const DEFAULT_SOFT_INTERVALS: u32 = 0;
+
 fn default_horizon_directions() -> u32 {
     DEFAULT_HORIZON_DIRECTIONS
 }

@@ -8,6 +8,7 @@ use relume::baked::images::{self, check_extension};
 use relume::baked::rasters;
 use relume::error::exit;
 use relume::heightmap::{HeightMap, HeightMapInfo};
+use relume::pipeline::knobs;
 use relume::progress::Progress;
 use relume::terrain::generate::{generate, quantise_u16, Shape};
 use relume::terrain::hard::relief::{self, HardMethod};
@@ -68,10 +69,10 @@ pub struct ReliefArgs {
     #[arg(long, value_name = "RELIEF.png")]
     pub shaded: Option<PathBuf>,
     /// Shadow brightness with the sun on the horizon
-    #[arg(long, default_value_t = 0.2, value_name = "K")]
+    #[arg(long, default_value_t = knobs::DEFAULT_K_DARK, value_name = "K")]
     pub k_dark: f64,
     /// Shadow brightness with the sun at the zenith
-    #[arg(long, default_value_t = 0.6, value_name = "K")]
+    #[arg(long, default_value_t = knobs::DEFAULT_K_BRIGHT, value_name = "K")]
     pub k_bright: f64,
 }
 
@@ -142,18 +143,18 @@ pub struct SoftShadowArgs {
     #[arg(long, value_enum, default_value_t = SoftMethodArg::BranchAndBound)]
     pub method: SoftMethodArg,
     /// Uniform: number of samples along the track
-    #[arg(long, value_name = "N", default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", default_value_t = knobs::DEFAULT_SOFT_STEPS, value_parser = clap::value_parser!(u32).range(1..))]
     pub steps: u32,
     /// Dynamic programming: mipmap level to start from (-1 = texels; clamped to the top)
     #[arg(
         long,
         value_name = "L",
-        default_value_t = 4,
+        default_value_t = knobs::DEFAULT_SOFT_START_LEVEL,
         allow_hyphen_values = true
     )]
     pub start_level: i32,
     /// Dynamic programming: intervals along the track (0 = as many as it needs)
-    #[arg(long, value_name = "K", default_value_t = 0)]
+    #[arg(long, value_name = "K", default_value_t = knobs::DEFAULT_SOFT_INTERVALS)]
     pub intervals: u32,
     /// Lit fraction to write: .png (16-bit, 65535 = fully lit), .exr (f32) or GeoTIFF .tif (f32)
     #[arg(long, value_name = "LIT.png|LIT.exr|LIT.tif")]
