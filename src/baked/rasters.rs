@@ -38,25 +38,9 @@ pub fn write_shadow_mask(
     mask: &[bool],
 ) -> Result<()> {
     if is_tiff(path) {
-        let px: Vec<u8> = (0..mask.len())
-            .map(|i| {
-                if is_nodata(info, i) {
-                    128
-                } else if mask[i] {
-                    0
-                } else {
-                    255
-                }
-            })
-            .collect();
-        write_geotiff_u8(
-            path,
-            map.width,
-            map.height,
-            &px,
-            info.georef.as_ref(),
-            Some(128),
-        )
+        let px = masked(info, mask.len(), 128u8, |i| if mask[i] { 0 } else { 255 });
+        let georef = info.georef.as_ref();
+        write_geotiff_u8(path, map.width, map.height, &px, georef, Some(128))
     } else {
         let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
         images::write_png_gray8(path, map.width, map.height, pixels)
@@ -72,17 +56,7 @@ pub fn write_lit_fraction(
     lit: &[f32],
 ) -> Result<()> {
     if is_tiff(path) {
-        let v: Vec<f32> = (0..lit.len())
-            .map(|i| if is_nodata(info, i) { -1.0 } else { lit[i] })
-            .collect();
-        write_geotiff_f32(
-            path,
-            map.width,
-            map.height,
-            &v,
-            info.georef.as_ref(),
-            Some(-1.0),
-        )
+        write_tiff_f32(path, map, info, lit, -1.0)
     } else if is_exr(path) {
         images::write_exr_gray(path, map.width, map.height, lit)
     } else {
@@ -105,23 +79,32 @@ pub fn write_float_raster(
     if is_exr(path) {
         return images::write_exr_gray(path, map.width, map.height, v);
     }
-    let v: Vec<f32> = (0..v.len())
-        .map(|i| {
-            if is_nodata(info, i) {
-                NODATA as f32
-            } else {
-                v[i]
-            }
-        })
-        .collect();
-    write_geotiff_f32(
-        path,
-        map.width,
-        map.height,
-        &v,
-        info.georef.as_ref(),
-        Some(NODATA),
-    )
+    write_tiff_f32(path, map, info, v, NODATA as f32)
+}
+
+/// `value(i)` for each of the `n` texels, `nodata` where the input had no data.
+fn masked<T: Copy>(
+    info: &HeightMapInfo,
+    n: usize,
+    nodata: T,
+    value: impl Fn(usize) -> T,
+) -> Vec<T> {
+    (0..n)
+        .map(|i| if is_nodata(info, i) { nodata } else { value(i) })
+        .collect()
+}
+
+/// A GeoTIFF f32 over `map` with the input's georeference, `nodata` where the input had none.
+fn write_tiff_f32(
+    path: &Path,
+    map: &HeightMap,
+    info: &HeightMapInfo,
+    v: &[f32],
+    nodata: f32,
+) -> Result<()> {
+    let v = masked(info, v.len(), nodata, |i| v[i]);
+    let georef = info.georef.as_ref();
+    write_geotiff_f32(path, map.width, map.height, &v, georef, Some(nodata as f64))
 }
 
 /// Write one horizon-angle GeoTIFF per azimuth of `hm` (degrees, f32) into `dir` (created if
