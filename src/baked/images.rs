@@ -88,6 +88,13 @@ pub fn is_exr(path: &Path) -> bool {
     )
 }
 
+/// Whether `path` ends in `.tif` or `.tiff` (any case).
+pub fn is_tiff(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("tif") || e.eq_ignore_ascii_case("tiff"))
+}
+
 /// Refuse output paths whose extension is not one of `allowed`.
 pub fn check_extension(path: &Path, allowed: &[&str]) -> Result<()> {
     let ext = path

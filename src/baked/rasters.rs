@@ -4,7 +4,7 @@
 //! georeference, the input's no-data texels written as the raster's no-data value; the other
 //! formats go through `baked::images` (atomic).
 
-use crate::baked::images::{self, is_exr};
+use crate::baked::images::{self, is_exr, is_tiff};
 use crate::error::{Error, Result};
 use crate::heightmap::georef::{write_geotiff_f32, write_geotiff_u8};
 use crate::heightmap::{HeightMap, HeightMapInfo};
@@ -16,13 +16,6 @@ use std::path::Path;
 
 /// The no-data value of float GeoTIFF rasters (horizon angles, sky view, sun hours).
 pub const NODATA: f64 = -9999.0;
-
-/// Whether `path` ends in `.tif` or `.tiff` (any case).
-pub fn is_tiff(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("tif") || e.eq_ignore_ascii_case("tiff"))
-}
 
 /// Whether texel `i` of the loaded map is no-data (false where the map has no mask).
 pub fn is_nodata(info: &HeightMapInfo, i: usize) -> bool {

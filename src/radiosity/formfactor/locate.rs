@@ -453,6 +453,19 @@ impl PatchLocator {
             // wall thinner than a voxel separates surfaces; then the nearest one decides).
             return Some(own.start as u32);
         }
+        self.search(p, axis, on, v, own)
+    }
+
+    /// The nearest-piece search of [`PatchLocator::locate_on`] past its early exit, in voxel `v`
+    /// whose patches of `axis` are `own` (not exactly one).
+    fn search(
+        &self,
+        p: DVec3,
+        axis: u8,
+        on: Option<u32>,
+        v: [i64; 3],
+        own: std::ops::Range<usize>,
+    ) -> Option<u32> {
         let mut bound = f64::INFINITY;
         if let Some(t) = on {
             for i in own {
@@ -504,7 +517,7 @@ impl PatchLocator {
                 return Some(i);
             }
         }
-        self.locate_on(p, axis, Some(t))
+        self.search(p, axis, Some(t), v, own)
     }
 
     /// [`PatchLocator::locate_hit`] by the nearest-piece search alone (the reference the table

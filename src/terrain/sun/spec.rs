@@ -84,16 +84,14 @@ pub fn place_of(
 ) -> Result<(Place, f64)> {
     let (cx, cy) = (map.width as f64 / 2.0, map.height as f64 / 2.0);
     let geo = info.georef.as_ref();
-    let (lat, lon) =
-        match given.or_else(|| geo.and_then(|g| g.lat_lon(cx, cy)).map(|[a, b]| (a, b))) {
-            Some(p) => p,
-            None => {
-                return Err(Error::knob(format!(
+    let (lat, lon) = given
+        .or_else(|| geo.and_then(|g| g.lat_lon(cx, cy)).map(|[a, b]| (a, b)))
+        .ok_or_else(|| {
+            Error::knob(format!(
                 "{what} needs a place: give --lat and --lon (this height map has no geographic \
                  or UTM georeference)"
-            )))
-            }
-        };
+            ))
+        })?;
     let centre = map.heights[(map.height / 2) * map.width + map.width / 2] as f64;
     let up = geo
         .and_then(|g| g.grid_north_bearing(cx, cy))
