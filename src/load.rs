@@ -57,6 +57,10 @@ pub struct SceneSummary {
     pub degenerate_triangles: usize,
     pub objects: Vec<String>,
     pub materials: Vec<crate::scene::Material>,
+    /// Each material's mean albedo over its texture (its albedo when untextured).
+    pub mean_albedos: Vec<[f32; 3]>,
+    /// The textures, `name width×height` (materials refer to them by index).
+    pub textures: Vec<String>,
     pub lights: Vec<crate::scene::Light>,
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
@@ -143,6 +147,12 @@ pub fn summarize_scene(path: &Path, scene: &Scene, warnings: &LoadWarnings) -> S
         degenerate_triangles: scene.degenerate_triangles().count(),
         objects: scene.objects.clone(),
         materials: scene.materials.clone(),
+        mean_albedos: scene.mean_albedos(),
+        textures: scene
+            .textures
+            .iter()
+            .map(|t| format!("{} {}×{}", t.name, t.width, t.height))
+            .collect(),
         lights: scene.lights.clone(),
         bounds_min: lo.to_array(),
         bounds_max: hi.to_array(),
@@ -200,11 +210,27 @@ impl SceneSummary {
             self.objects.join(", "),
             self.materials.len()
         );
-        for m in &self.materials {
+        for (m, mean) in self.materials.iter().zip(&self.mean_albedos) {
             t += &format!(
                 "  {:<16} albedo {:?}  emission {:?}\n",
                 m.name, m.albedo, m.emission
             );
+            if let Some(r) = &m.albedo_texture {
+                t += &format!(
+                    "  {:<16} × texture {} (mean albedo {:.3?})\n",
+                    "", self.textures[r.texture as usize], mean
+                );
+            }
+            if let Some(a) = &m.alpha {
+                let what = match &a.texture {
+                    Some((r, ch)) => format!("{:?} of {}", ch, self.textures[r.texture as usize]),
+                    None => "no texture".into(),
+                };
+                t += &format!(
+                    "  {:<16} alpha mask: {} × {what}, cut below {}\n",
+                    "", a.factor, a.cutoff
+                );
+            }
         }
         t += &format!("lights     {}\n", self.lights.len());
         for l in &self.lights {

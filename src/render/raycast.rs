@@ -36,7 +36,7 @@ impl RaycastScene {
             triangle_object: vec![0; corners / 3],
             objects: vec!["all".into()],
             materials: vec![Material::default_grey()],
-            lights: Vec::new(),
+            ..Default::default()
         };
         let live = flat.live_triangles();
         let (lo, hi) = flat.bounds();

@@ -81,11 +81,9 @@ impl SceneBuilder {
 
     /// Add a material; returns its index.
     pub fn material(&mut self, name: &str, albedo: [f32; 3], emission: [f32; 3]) -> u32 {
-        self.scene.materials.push(Material {
-            name: name.into(),
-            albedo,
-            emission,
-        });
+        self.scene
+            .materials
+            .push(Material::plain(name, albedo, emission));
         (self.scene.materials.len() - 1) as u32
     }
 

@@ -1,13 +1,16 @@
 //! glTF 2.0 (`.gltf` with external or embedded buffers, `.glb`) through the `gltf` crate.
 //!
 //! Node transforms are applied (negative-determinant transforms flip the winding back);
-//! `baseColorFactor` × the mean linear colour of `baseColorTexture` → albedo;
+//! `baseColorFactor` → albedo factor, `baseColorTexture` (its `texCoord` set, sampler wrap modes
+//! and `KHR_texture_transform`) → albedo texture; `alphaMode` `MASK` (at `alphaCutoff`) and
+//! `BLEND` (at 0.5) → alpha mask from the factor's and the texture's alpha;
 //! `emissiveFactor` × `KHR_materials_emissive_strength` → emitted radiance;
 //! `KHR_lights_punctual` directional, point and spot lights → [`Light`]s.
 
+use super::texture::{AlphaMask, Channel, Texture, TextureRef, Wrap};
 use super::{Light, LightKind, LoadWarnings, Material, Scene};
 use crate::error::{Error, Result};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 use gltf::mesh::Mode;
 use std::path::Path;
 
@@ -24,18 +27,48 @@ fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
 
     let mut scene = Scene::default();
     // Materials first so that indices are stable; glTF's default material (no `material`) is last.
+    // The texture coordinate set each material's base colour reads, per material.
     let mut material_ids = Vec::new();
+    let mut uv_sets = Vec::new();
+    let mut image_ids: Vec<Option<u32>> = vec![None; images.len()];
     for m in doc.materials() {
         let pbr = m.pbr_metallic_roughness();
+        let factor = pbr.base_color_factor();
         let mut albedo = [0.0f32; 3];
-        albedo.copy_from_slice(&pbr.base_color_factor()[..3]);
-        if let Some(info) = pbr.base_color_texture() {
-            let image = &images[info.texture().source().index()];
-            let mean = mean_linear_rgb(image);
-            for c in 0..3 {
-                albedo[c] *= mean[c];
+        albedo.copy_from_slice(&factor[..3]);
+        let texture = match pbr.base_color_texture() {
+            Some(info) => {
+                let source = info.texture().source().index();
+                let id = match image_ids[source] {
+                    Some(id) => id,
+                    None => {
+                        let name = format!("{}#image {source}", path.display());
+                        scene.textures.push(texture_of(path, name, &images[source])?);
+                        let id = (scene.textures.len() - 1) as u32;
+                        image_ids[source] = Some(id);
+                        id
+                    }
+                };
+                let (reference, set) = reference(id, &info);
+                uv_sets.push(Some(set));
+                Some(reference)
             }
-        }
+            None => {
+                uv_sets.push(None);
+                None
+            }
+        };
+        let alpha = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => None,
+            mode => Some(AlphaMask {
+                factor: factor[3],
+                texture: texture.clone().map(|t| (t, Channel::Alpha)),
+                cutoff: match mode {
+                    gltf::material::AlphaMode::Mask => m.alpha_cutoff().unwrap_or(0.5),
+                    _ => 0.5,
+                },
+            }),
+        };
         let strength = m.emissive_strength().unwrap_or(1.0);
         let emission = m.emissive_factor().map(|e| e * strength);
         let name = m
@@ -46,8 +79,11 @@ fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
             name,
             albedo,
             emission,
+            albedo_texture: texture,
+            alpha,
         }));
     }
+    let mut uvs: Vec<[f32; 2]> = Vec::new();
 
     let gltf_scene = doc.default_scene().or_else(|| doc.scenes().next());
     let Some(gltf_scene) = gltf_scene else {
@@ -120,14 +156,33 @@ fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
                         continue;
                     }
                 };
-                let material = match prim.material().index() {
+                let mut material = match prim.material().index() {
                     Some(i) => material_ids[i],
-                    None => scene.material_index(Material {
-                        name: "gltf-default".into(),
-                        albedo: [1.0; 3],
-                        emission: [0.0; 3],
-                    }),
+                    None => scene.material_index(Material::plain("gltf-default", [1.0; 3], [0.0; 3])),
                 };
+                let set = prim.material().index().and_then(|i| uv_sets[i]);
+                let coords = set.and_then(|s| reader.read_tex_coords(s)).map(|t| t.into_f32());
+                match coords {
+                    Some(t) => {
+                        uvs.resize(base as usize, [0.0; 2]);
+                        uvs.extend(t.take(count as usize));
+                        uvs.resize((base + count) as usize, [0.0; 2]);
+                    }
+                    None if set.is_some() => {
+                        let mut plain = scene.materials[material as usize].clone();
+                        warnings.push(format!(
+                            "{}: mesh `{}` uses textured material `{}` but has no TEXCOORD_{}; using its colour factor alone",
+                            path.display(),
+                            scene.objects[object as usize],
+                            plain.name,
+                            set.unwrap_or(0)
+                        ));
+                        plain.albedo_texture = None;
+                        plain.alpha = plain.alpha.filter(|a| a.texture.is_none());
+                        material = scene.material_index(plain);
+                    }
+                    None => {}
+                }
                 for t in tris {
                     let t = if flip { [t[0], t[2], t[1]] } else { t };
                     scene.triangles.push(t.map(|i| base + i));
@@ -168,6 +223,10 @@ fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
     }
     if scene.triangles.is_empty() {
         return Err(Error::input(path, "the glTF scene has no triangles"));
+    }
+    if !uvs.is_empty() {
+        uvs.resize(scene.positions.len(), [0.0; 2]);
+        scene.uvs = uvs;
     }
     Ok(scene)
 }
@@ -231,8 +290,31 @@ fn describe(path: &Path, e: gltf::Error) -> Error {
     }
 }
 
-/// Mean linear RGB of a decoded glTF image (sRGB-encoded 8/16-bit, or float).
-fn mean_linear_rgb(image: &gltf::image::Data) -> [f32; 3] {
+/// The reference a material's base-colour texture makes (sampler wrap modes,
+/// `KHR_texture_transform` as `T·R·S`), and the texture coordinate set it reads.
+fn reference(id: u32, info: &gltf::texture::Info) -> (TextureRef, u32) {
+    use gltf::texture::WrappingMode as W;
+    let wrap = |w: W| match w {
+        W::Repeat => Wrap::Repeat,
+        W::ClampToEdge => Wrap::ClampToEdge,
+        W::MirroredRepeat => Wrap::MirroredRepeat,
+    };
+    let sampler = info.texture().sampler();
+    let mut r = TextureRef::new(id);
+    r.wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
+    let mut set = info.tex_coord();
+    if let Some(t) = info.texture_transform() {
+        let ([ox, oy], a, [sx, sy]) = (t.offset(), t.rotation(), t.scale());
+        let (sin, cos) = a.sin_cos();
+        r.transform = [[cos * sx, sin * sy, ox], [-sin * sx, cos * sy, oy]];
+        set = t.tex_coord().unwrap_or(set);
+    }
+    (r, set)
+}
+
+/// A decoded glTF image as a texture: 8-bit kept, 16-bit rounded to 8, float sRGB-encoded;
+/// grey (R) and grey-alpha (RG) images become RGB(A) with R = G = B.
+fn texture_of(path: &Path, name: String, image: &gltf::image::Data) -> Result<Texture> {
     use gltf::image::Format::*;
     let (channels, bytes): (usize, usize) = match image.format {
         R8 => (1, 1),
@@ -247,33 +329,33 @@ fn mean_linear_rgb(image: &gltf::image::Data) -> [f32; 3] {
         R32G32B32A32FLOAT => (4, 4),
     };
     let texel = channels * bytes;
-    let n = image.pixels.len() / texel.max(1);
-    if n == 0 {
-        return [1.0; 3];
+    let n = image.width as usize * image.height as usize;
+    if image.pixels.len() != n * texel {
+        return Err(Error::input(
+            path,
+            format!("image `{name}` holds {} bytes for {n} texels", image.pixels.len()),
+        ));
     }
-    let mut sum = [0.0f64; 3];
-    for px in image.pixels.chunks_exact(texel) {
-        for (c, s) in sum.iter_mut().enumerate() {
-            let ch = c.min(channels - 1);
-            let v = match bytes {
-                1 => srgb_to_linear(px[ch] as f32 / 255.0),
-                2 => srgb_to_linear(
-                    u16::from_le_bytes([px[2 * ch], px[2 * ch + 1]]) as f32 / 65535.0,
-                ),
-                _ => f32::from_le_bytes(px[4 * ch..4 * ch + 4].try_into().unwrap()),
-            };
-            *s += v as f64;
+    let value = |px: &[u8], ch: usize, colour: bool| -> u8 {
+        match bytes {
+            1 => px[ch],
+            2 => (u16::from_le_bytes([px[2 * ch], px[2 * ch + 1]]) as f32 / 257.0).round() as u8,
+            _ => {
+                let v = f32::from_le_bytes(px[4 * ch..4 * ch + 4].try_into().unwrap());
+                let v = if colour { super::texture::linear_to_srgb(v.max(0.0)) } else { v };
+                (v.clamp(0.0, 1.0) * 255.0).round() as u8
+            }
         }
+    };
+    let mut texels = Vec::with_capacity(4 * n);
+    for px in image.pixels.chunks_exact(texel) {
+        let rgb = |c: usize| value(px, if channels < 3 { 0 } else { c }, true);
+        let alpha = match channels {
+            2 => value(px, 1, false),
+            4 => value(px, 3, false),
+            _ => 255,
+        };
+        texels.extend([rgb(0), rgb(1), rgb(2), alpha]);
     }
-    let v = Vec4::new(sum[0] as f32, sum[1] as f32, sum[2] as f32, 0.0) / n as f32;
-    [v.x, v.y, v.z]
-}
-
-/// The sRGB transfer function's inverse (IEC 61966-2-1).
-pub(crate) fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    Texture::from_rgba8(name, image.width, image.height, texels)
 }

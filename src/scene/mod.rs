@@ -11,24 +11,33 @@ pub mod freeform;
 pub mod generate;
 mod gltf_loader;
 pub mod light_spec;
+pub mod mtl;
 mod obj_loader;
 pub mod obj_writer;
 pub mod punctual;
 pub mod shape_texture;
+pub mod texture;
 
 use crate::error::{Error, Result};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+use texture::{AlphaMask, Texture, TextureRef};
 
-/// A diffuse material: albedo (reflectance, linear RGB in [0, 1]) and emitted radiance.
+/// A diffuse material: albedo (reflectance, linear RGB in [0, 1]), optionally textured and
+/// alpha-masked, and emitted radiance.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Material {
     pub name: String,
-    /// Diffuse reflectance ρ per channel, linear RGB, each in [0, 1].
+    /// Diffuse reflectance ρ per channel, linear RGB, each in [0, 1]; with a texture, the factor
+    /// the texture's linear colour is multiplied by (OBJ `Kd`, glTF `baseColorFactor`).
     pub albedo: [f32; 3],
     /// Emitted radiance L per channel (W·m⁻²·sr⁻¹). The exitance of a Lambertian emitter is π·L.
     pub emission: [f32; 3],
+    /// The albedo texture (OBJ `map_Kd`, glTF `baseColorTexture`).
+    pub albedo_texture: Option<TextureRef>,
+    /// Where the surface is cut away (None: opaque everywhere).
+    pub alpha: Option<AlphaMask>,
 }
 
 impl Material {
@@ -38,7 +47,25 @@ impl Material {
             name: "default".into(),
             albedo: [0.5; 3],
             emission: [0.0; 3],
+            albedo_texture: None,
+            alpha: None,
         }
+    }
+
+    /// A plain material: one albedo, one emitted radiance, no texture, opaque.
+    pub fn plain(name: impl Into<String>, albedo: [f32; 3], emission: [f32; 3]) -> Self {
+        Material {
+            name: name.into(),
+            albedo,
+            emission,
+            albedo_texture: None,
+            alpha: None,
+        }
+    }
+
+    /// True when a texture modulates the albedo or the alpha.
+    pub fn is_textured(&self) -> bool {
+        self.albedo_texture.is_some() || self.alpha.as_ref().is_some_and(|a| a.texture.is_some())
     }
 
     /// True when the material emits light in any channel.
@@ -89,6 +116,11 @@ pub struct Scene {
     pub objects: Vec<String>,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
+    /// Texture coordinates per vertex (glTF frame: origin top-left, v down); empty when no
+    /// triangle has any. Vertices of untextured objects hold (0, 0).
+    pub uvs: Vec<[f32; 2]>,
+    /// The images materials refer to.
+    pub textures: Vec<Texture>,
 }
 
 /// What a loader noticed but did not treat as an error.
@@ -220,7 +252,26 @@ impl Scene {
                 path.display()
             )));
         }
+        if !self.uvs.is_empty() && self.uvs.len() != self.positions.len() {
+            return Err(Error::Internal(format!(
+                "{}: loader produced {} texture coordinates for {} vertices",
+                path.display(),
+                self.uvs.len(),
+                self.positions.len()
+            )));
+        }
+        if let Some(i) = self.uvs.iter().position(|t| t.iter().any(|c| !c.is_finite())) {
+            return Err(Error::input(
+                path,
+                format!(
+                    "vertex {} has a non-finite texture coordinate {:?}",
+                    i + 1,
+                    self.uvs[i]
+                ),
+            ));
+        }
         for m in &self.materials {
+            self.validate_textures(path, m)?;
             if m.albedo
                 .iter()
                 .chain(&m.emission)
@@ -242,6 +293,65 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// Texture references of `m` point at textures that exist, with finite transforms, and its
+    /// alpha factor and cutoff are finite numbers.
+    fn validate_textures(&self, path: &Path, m: &Material) -> Result<()> {
+        let refs = m
+            .albedo_texture
+            .iter()
+            .chain(m.alpha.iter().flat_map(|a| a.texture.as_ref().map(|t| &t.0)));
+        for r in refs {
+            if r.texture as usize >= self.textures.len() {
+                return Err(Error::Internal(format!(
+                    "{}: material `{}` names texture {} of {}",
+                    path.display(),
+                    m.name,
+                    r.texture,
+                    self.textures.len()
+                )));
+            }
+            if r.transform.iter().flatten().any(|c| !c.is_finite()) {
+                return Err(Error::input(
+                    path,
+                    format!(
+                        "material `{}` has a non-finite texture transform {:?}",
+                        m.name, r.transform
+                    ),
+                ));
+            }
+        }
+        if let Some(a) = &m.alpha {
+            if !(a.factor.is_finite() && a.cutoff.is_finite()) {
+                return Err(Error::input(
+                    path,
+                    format!(
+                        "material `{}` has a non-finite alpha ({} cut at {})",
+                        m.name, a.factor, a.cutoff
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The mean albedo of material `m` over its texture (factor × the texture's mean linear
+    /// colour), its albedo when untextured: one colour per material, for reports and
+    /// per-material decisions.
+    pub fn mean_albedo(&self, m: &Material) -> [f32; 3] {
+        match &m.albedo_texture {
+            None => m.albedo,
+            Some(t) => {
+                let mean = t.of(&self.textures).mean_linear_rgb();
+                [0, 1, 2].map(|c| m.albedo[c] * mean[c])
+            }
+        }
+    }
+
+    /// [`Scene::mean_albedo`] of every material, in order.
+    pub fn mean_albedos(&self) -> Vec<[f32; 3]> {
+        self.materials.iter().map(|m| self.mean_albedo(m)).collect()
     }
 
     /// The three corners of triangle `t`.
@@ -300,9 +410,14 @@ impl Scene {
     /// True when every material is grey (R = G = B albedo): one colour channel suffices for the
     /// transport matrix.
     pub fn is_grey(&self) -> bool {
-        self.materials
-            .iter()
-            .all(|m| m.albedo[0] == m.albedo[1] && m.albedo[1] == m.albedo[2])
+        self.materials.iter().all(|m| {
+            m.albedo[0] == m.albedo[1]
+                && m.albedo[1] == m.albedo[2]
+                && m
+                    .albedo_texture
+                    .as_ref()
+                    .is_none_or(|t| t.of(&self.textures).is_grey())
+        })
     }
 
     /// Index of a material with this name, adding it when absent.

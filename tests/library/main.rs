@@ -21,5 +21,6 @@ mod history;
 mod independent_decoders;
 mod loaders;
 mod reorder_bounded;
+mod textures;
 mod themes;
 mod themes_geo;

@@ -59,7 +59,9 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
     let vis = set.visibility(scene);
     let transfer = PointTransfer::with_cells(scene, set, &vis, cells);
     // Per scene triangle: its sub-triangles' corner positions and lists, three per sub-triangle.
-    type Part = (Vec<[f32; 3]>, Vec<Vec<(u32, f32)>>);
+    // Texture coordinates ride along (empty when the scene has none).
+    type Part = (Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<Vec<(u32, f32)>>);
+    let has_uv = !scene.uvs.is_empty();
     let parts: Vec<Part> = (0..scene.triangles.len())
         .into_par_iter()
         .map(|t| {
@@ -68,9 +70,11 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
                 let (p, w) = set.corners.list(3 * t + k);
                 p.iter().copied().zip(w.iter().copied()).collect::<Vec<_>>()
             };
+            let tri_uv = has_uv.then(|| scene.triangles[t].map(|v| scene.uvs[v as usize]));
             if m == 1 {
                 let pos = scene.triangles[t].map(|v| scene.positions[v as usize]);
-                return (pos.to_vec(), (0..3).map(own).collect());
+                let uv = tri_uv.map(|t| t.to_vec()).unwrap_or_default();
+                return (pos.to_vec(), uv, (0..3).map(own).collect());
             }
             // The grid vertices (i, j), i + j ≤ m, at barycentric (1 − (i + j)/m, i/m, j/m),
             // row by row; the scene's own corners keep the bake's lists.
@@ -84,19 +88,24 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
                 for j in 0..=m - i {
                     let (u, v) = (i as f64 / m as f64, j as f64 / m as f64);
                     let p = (c[0] + (c[1] - c[0]) * u + (c[2] - c[0]) * v).as_vec3();
+                    let uv = tri_uv.map(|t| {
+                        let (u, v) = (u as f32, v as f32);
+                        [0, 1].map(|k| t[0][k] + (t[1][k] - t[0][k]) * u + (t[2][k] - t[0][k]) * v)
+                    });
                     let w = match (i, j) {
                         (0, 0) => own(0),
                         (i, 0) if i == m => own(1),
                         (0, j) if j == m => own(2),
                         _ => on.weights(p),
                     };
-                    verts.push((p.to_array(), w));
+                    verts.push((p.to_array(), uv, w));
                 }
             }
-            let (mut pos, mut lists) = (Vec::new(), Vec::new());
+            let (mut pos, mut uvs, mut lists) = (Vec::new(), Vec::new(), Vec::new());
             let mut corner = |i: usize, j: usize| {
-                let (p, w) = &verts[index(i, j)];
+                let (p, uv, w) = &verts[index(i, j)];
                 pos.push(*p);
+                uvs.extend(*uv);
                 lists.push(w.clone());
             };
             for i in 0..m {
@@ -111,17 +120,19 @@ pub fn display_mesh(scene: &Scene, set: &PatchSet, max_edge: f64) -> (Scene, Pat
                     }
                 }
             }
-            (pos, lists)
+            (pos, uvs, lists)
         })
         .collect();
     let mut out = Scene {
         objects: scene.objects.clone(),
         materials: scene.materials.clone(),
         lights: scene.lights.clone(),
+        textures: scene.textures.clone(),
         ..Default::default()
     };
     let mut all_lists = Vec::new();
-    for (t, (pos, lists)) in parts.into_iter().enumerate() {
+    for (t, (pos, uvs, lists)) in parts.into_iter().enumerate() {
+        out.uvs.extend(uvs);
         for corners in pos.chunks_exact(3) {
             let base = out.positions.len() as u32;
             out.positions.extend_from_slice(corners);

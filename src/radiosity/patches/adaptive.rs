@@ -141,7 +141,7 @@ pub struct Refinement {
 }
 
 /// Split each cluster of `groups` (pieces by (voxel, axis) group) into cells of matching
-/// material; also returns how many cells the split added.
+/// material (by each material's mean albedo over its texture); also returns how many cells the split added.
 pub fn by_material(
     scene: &Scene,
     groups: Vec<(u64, Vec<usize>)>,
@@ -151,9 +151,10 @@ pub fn by_material(
 ) -> (Vec<Cell>, usize) {
     let mut cells: Vec<Cell> = Vec::new();
     let mut added = 0;
+    let means = scene.mean_albedos();
     for (key, members) in groups {
         let (voxel, _) = split_key(key, dims);
-        let classes = material_classes(scene, &members, pieces, tolerance);
+        let classes = material_classes(scene, &means, &members, pieces, tolerance);
         added += classes.len() - 1;
         cells.extend(classes.into_iter().map(|members| Cell {
             key,
@@ -260,6 +261,7 @@ pub fn refine(
 /// Split `members` into classes of matching material, in order of first appearance.
 fn material_classes(
     scene: &Scene,
+    means: &[[f32; 3]],
     members: &[usize],
     pieces: &[(u64, Piece)],
     tolerance: f64,
@@ -267,17 +269,18 @@ fn material_classes(
     let mut classes: Vec<([f32; 3], [f32; 3], Vec<usize>)> = Vec::new();
     for &i in members {
         let t = pieces[i].1.triangle as usize;
-        let m = &scene.materials[scene.triangle_material[t] as usize];
+        let material = scene.triangle_material[t] as usize;
+        let (m, albedo) = (&scene.materials[material], means[material]);
         let fits = |a: &[f32; 3], e: &[f32; 3]| {
             (0..3).all(|c| {
-                (a[c] - m.albedo[c]).abs() as f64 <= tolerance
+                (a[c] - albedo[c]).abs() as f64 <= tolerance
                     && (e[c] - m.emission[c]).abs() as f64
                         <= tolerance * e[c].max(m.emission[c]) as f64
             })
         };
         match classes.iter_mut().find(|(a, e, _)| fits(a, e)) {
             Some(class) => class.2.push(i),
-            None => classes.push((m.albedo, m.emission, vec![i])),
+            None => classes.push((albedo, m.emission, vec![i])),
         }
     }
     classes.into_iter().map(|c| c.2).collect()

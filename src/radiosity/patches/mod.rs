@@ -7,10 +7,13 @@
 //! - [`clip`]: clipping triangles to voxels and clustering the pieces;
 //! - [`voxel_size`]: the voxel size for a target patch count (bisection);
 //! - [`adaptive`]: the octree refinement of `Adaptive` (finer where geometry or light varies);
+//! - [`albedo`]: albedo and opaque coverage of textured, alpha-masked pieces (exact
+//!   texture-space integration);
 //! - [`corners`]: which patches each scene triangle corner interpolates (the display side of
 //!   a patch set, computed with it).
 
 pub mod adaptive;
+pub mod albedo;
 pub mod clip;
 pub mod corners;
 pub mod overlap;

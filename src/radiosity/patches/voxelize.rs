@@ -9,7 +9,9 @@
 //!    each group into clusters of pieces that see each other (the segment between their centroids,
 //!    lifted off the surface, is unoccluded). Each cluster is one patch: area = summed area,
 //!    centroid = area-weighted centroid, normal = normalised area-weighted normal, albedo and
-//!    emitted radiance = area-weighted means. The visibility split keeps the two floors on either
+//!    emitted radiance = area-weighted means. Textured pieces bring the mean of factor × texture
+//!    over themselves, and alpha-masked ones only their opaque area
+//!    ([`crate::radiosity::patches::albedo`]); a patch whose pieces are all cut out is dropped. The visibility split keeps the two floors on either
 //!    side of a wall thinner than a voxel apart, so light does not leak through the wall.
 //! 5. Draw `samples_per_patch` points on each patch's pieces for the runtime's direct light, and
 //!    compute the per-triangle-corner transfer ([`crate::radiosity::transfer`]).
@@ -22,6 +24,7 @@ use crate::progress::Silent;
 use crate::radiosity::formfactor::{form_factors, Estimator, FormFactorParams};
 use crate::radiosity::geometry::{self, axis_vector, split_key, Frame};
 use crate::radiosity::patches::adaptive::{self, AdaptiveParams, Cell};
+use crate::radiosity::patches::albedo;
 use crate::radiosity::patches::clip::{clip_pieces, clusters, grid_dims, SNAP};
 use crate::radiosity::patches::overlap::{self, Face};
 use crate::radiosity::patches::voxel_size::SizeSearch;
@@ -164,9 +167,12 @@ pub fn voxelize_noting(
         dims,
         ..Default::default()
     };
+    let surfaces = albedo::piece_surfaces(scene, &frame, &pieces);
     for (key, members) in groups {
-        let patch = build_patch(scene, &frame, key, dims, &members, &pieces, &mut set);
-        set.patches.push(patch);
+        let cut = Cut::Textured(&surfaces);
+        if let Some(patch) = build_patch(scene, &frame, key, dims, &members, &pieces, cut, &mut set) {
+            set.patches.push(patch);
+        }
     }
     drop(pieces);
 
@@ -274,9 +280,12 @@ fn coarse_light(
         dims,
         ..Default::default()
     };
+    let means = scene.mean_albedos();
     for c in cells {
-        let patch = build_patch(scene, frame, c.key, dims, &c.members, pieces, &mut set);
-        set.patches.push(patch);
+        let cut = Cut::MaterialMeans(&means);
+        if let Some(patch) = build_patch(scene, frame, c.key, dims, &c.members, pieces, cut, &mut set) {
+            set.patches.push(patch);
+        }
     }
     let params = FormFactorParams {
         estimator: Estimator::HemisphereReciprocal,
@@ -309,6 +318,19 @@ fn coarse_light(
     Some(h)
 }
 
+/// What a textured piece reflects and keeps.
+#[derive(Clone, Copy)]
+enum Cut<'a> {
+    /// Per piece, from its textures ([`albedo::piece_surfaces`], indexed like the pieces).
+    Textured(&'a [Option<albedo::Surface>]),
+    /// Each material's mean albedo ([`Scene::mean_albedos`]), opaque everywhere: the coarse
+    /// bake that guides adaptive refinement, before the pieces are final.
+    MaterialMeans(&'a [[f32; 3]]),
+}
+
+/// The patch made of `members` (indices into `pieces`), its pieces appended to `set.pieces`;
+/// None when alpha masks cut all of them away.
+#[allow(clippy::too_many_arguments)]
 fn build_patch(
     scene: &Scene,
     frame: &Frame,
@@ -316,27 +338,49 @@ fn build_patch(
     dims: [u32; 3],
     members: &[usize],
     pieces: &[(u64, Piece)],
+    cut: Cut,
     set: &mut PatchSet,
-) -> Patch {
+) -> Option<Patch> {
     let (voxel, axis) = split_key(key, dims);
     let first_piece = set.pieces.len() as u32;
-    let (area, centroid, normal) =
-        crate::radiosity::piece_moments(members.iter().map(|&i| &pieces[i].1));
-    let (mut albedo, mut emission) = (DVec3::ZERO, DVec3::ZERO);
-    let mut objects = Vec::new();
+    // Each kept piece with its albedo; a piece's area counts only its opaque part.
+    let mut kept: Vec<(Piece, DVec3)> = Vec::with_capacity(members.len());
     for &i in members {
         let p = &pieces[i].1;
+        let material = scene.triangle_material[p.triangle as usize] as usize;
+        let (surface, plain) = match cut {
+            Cut::Textured(s) => (s[i], scene.materials[material].albedo),
+            Cut::MaterialMeans(means) => (None, means[material]),
+        };
+        match surface {
+            Some(s) if s.coverage <= 0.0 => {}
+            Some(s) => {
+                let mut p = p.clone();
+                p.area *= s.coverage;
+                kept.push((p, s.albedo));
+            }
+            None => kept.push((p.clone(), glam::Vec3::from(plain).as_dvec3())),
+        }
+    }
+    if kept.is_empty() {
+        return None;
+    }
+    let (area, centroid, normal) = crate::radiosity::piece_moments(kept.iter().map(|(p, _)| p));
+    let (mut albedo, mut emission) = (DVec3::ZERO, DVec3::ZERO);
+    let mut objects = Vec::new();
+    let piece_count = kept.len() as u32;
+    for (p, rho) in kept {
         let t = p.triangle as usize;
         let m = &scene.materials[scene.triangle_material[t] as usize];
-        albedo += p.area * glam::Vec3::from(m.albedo).as_dvec3();
+        albedo += p.area * rho;
         emission += p.area * glam::Vec3::from(m.emission).as_dvec3();
         objects.push(scene.triangle_object[t]);
-        set.pieces.push(p.clone());
+        set.pieces.push(p);
     }
     objects.sort_unstable();
     objects.dedup();
     let normal = normal.try_normalize().unwrap_or_else(|| axis_vector(axis));
-    Patch {
+    Some(Patch {
         voxel,
         axis,
         area: (area * frame.scale * frame.scale) as f32,
@@ -345,9 +389,9 @@ fn build_patch(
         albedo: (albedo / area).as_vec3().to_array(),
         emission: (emission / area).as_vec3().to_array(),
         first_piece,
-        piece_count: members.len() as u32,
+        piece_count,
         objects,
-    }
+    })
 }
 
 /// For every scene triangle, the patches its visible pieces feed and the area (world units) each.

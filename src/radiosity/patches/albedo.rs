@@ -1,0 +1,406 @@
+//! Albedo and opaque coverage of textured pieces: the mean of factor × texture over the part of a
+//! piece its alpha mask keeps, and the fraction it keeps.
+//!
+//! A piece is a planar polygon inside one scene triangle, so the affine map from the triangle to
+//! its texture coordinates takes it to a polygon in texel space, and its mean albedo is the mean
+//! of the texture over that polygon (an affine map scales every area by the same factor). The
+//! texture is read as a piecewise-constant function (one value per texel, nearest-texel lookup,
+//! linear light) and integrated over the polygon **exactly**, in time proportional to its
+//! boundary rather than its area:
+//!
+//! - a summed-area table (Crow, 1984) over one copy of the image gives the sum over any
+//!   texel-aligned rectangle in O(1); a rectangle outside the image is split along each axis
+//!   into pieces of the image by the wrap mode (repeat, mirrored repeat, clamp to edge);
+//! - the polygon's bounding rectangle is halved recursively; a cell the polygon covers entirely
+//!   adds its table sum, a cell it misses adds nothing, a single texel it covers in part adds its
+//!   value times the covered area (exact, since the texel is constant).
+//!
+//! Polygons whose boundary crosses more than [`MAX_BOUNDARY_CELLS`] texels stop the recursion at
+//! cells of several texels and weight the cell's mean by the covered area. The error is then at
+//! most the area of those boundary cells over the polygon's times the texture's range, a few
+//! percent of a piece that spans hundreds of texels along its edge; [`Integral::bound`] reports
+//! it. Preconditions: the scene passed [`Scene::validate`] and the pieces lie in their triangles.
+
+use crate::radiosity::Piece;
+use crate::raytrace::Frame;
+use crate::scene::texture::{channel_value, srgb_table, Texture, TextureRef, Wrap};
+use crate::scene::{Material, Scene};
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+/// Most boundary cells of one polygon's recursion (so at most ~4× this many cells visited).
+pub const MAX_BOUNDARY_CELLS: f64 = 512.0;
+
+/// What a textured piece reflects and keeps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surface {
+    /// Mean linear albedo (factor included) over the opaque part.
+    pub albedo: DVec3,
+    /// Fraction of the piece's area that is opaque, in [0, 1].
+    pub coverage: f64,
+}
+
+/// The surface of every piece whose material is textured or alpha-masked (None: the material's
+/// plain albedo, opaque). Materials are processed one at a time, pieces in parallel.
+pub fn piece_surfaces(scene: &Scene, frame: &Frame, pieces: &[(u64, Piece)]) -> Vec<Option<Surface>> {
+    let mut out = vec![None; pieces.len()];
+    for (mi, m) in scene.materials.iter().enumerate() {
+        let mine: Vec<usize> = (0..pieces.len())
+            .filter(|&i| scene.triangle_material[pieces[i].1.triangle as usize] as usize == mi)
+            .collect();
+        if mine.is_empty() || (m.albedo_texture.is_none() && m.alpha.is_none()) {
+            continue;
+        }
+        let tables = MaterialTables::new(scene, m);
+        let found: Vec<Surface> = mine
+            .par_iter()
+            .map(|&i| tables.surface(scene, frame, &pieces[i].1))
+            .collect();
+        for (i, s) in mine.into_iter().zip(found) {
+            out[i] = Some(s);
+        }
+    }
+    out
+}
+
+/// The summed-area tables a material needs: colour × opaque and opaque on the colour texture's
+/// texels, and a separate opaque table when the mask is another image or mapping.
+struct MaterialTables {
+    factor: DVec3,
+    colour: Option<(TextureRef, Table)>,
+    /// True when `colour`'s fourth channel is the mask (one image and mapping for both).
+    mask_in_colour: bool,
+    /// A mask read through another reference than the colour's.
+    mask: Option<(TextureRef, Table)>,
+    /// The material's coverage when no texture decides it (alpha factor alone, or opaque).
+    constant_coverage: f64,
+}
+
+impl MaterialTables {
+    fn new(scene: &Scene, m: &Material) -> Self {
+        let lut = srgb_table();
+        let alpha = m.alpha.as_ref();
+        let mask_ref = alpha.and_then(|a| a.texture.as_ref());
+        let opaque = |t: [u8; 4]| match (alpha, mask_ref) {
+            (Some(a), Some((_, channel))) => !a.cuts(a.factor * channel_value(t, *channel)) as u8 as f64,
+            _ => 1.0,
+        };
+        let mask_in_colour = match (&m.albedo_texture, mask_ref) {
+            (Some(c), Some((r, _))) => same_lookup(scene, c, r),
+            _ => false,
+        };
+        let colour = m.albedo_texture.as_ref().map(|r| {
+            let table = Table::new(r.of(&scene.textures), |t| {
+                let o = if mask_in_colour { opaque(t) } else { 1.0 };
+                let [r, g, b] = [0, 1, 2].map(|c| o * lut[t[c] as usize] as f64);
+                [r, g, b, o]
+            });
+            (r.clone(), table.with_wrap(r.wrap))
+        });
+        let mask = mask_ref.filter(|_| !mask_in_colour).map(|(r, _)| {
+            let table = Table::new(r.of(&scene.textures), |t| [0.0, 0.0, 0.0, opaque(t)]);
+            (r.clone(), table.with_wrap(r.wrap))
+        });
+        let constant_coverage = match alpha {
+            Some(a) if a.texture.is_none() => !a.cuts(a.factor) as u8 as f64,
+            _ => 1.0,
+        };
+        MaterialTables {
+            factor: glam::Vec3::from(m.albedo).as_dvec3(),
+            colour,
+            mask_in_colour,
+            mask,
+            constant_coverage,
+        }
+    }
+
+    fn surface(&self, scene: &Scene, frame: &Frame, piece: &Piece) -> Surface {
+        let mut coverage = self.constant_coverage;
+        let mut albedo = self.factor;
+        if let Some((r, table)) = &self.colour {
+            let i = table.integrate(&texel_polygon(scene, frame, piece, r, table.size()));
+            if i.sum[3] > 0.0 {
+                albedo *= DVec3::new(i.sum[0], i.sum[1], i.sum[2]) / i.sum[3];
+            }
+            if self.mask_in_colour {
+                coverage = i.sum[3] / i.area;
+            }
+        }
+        if let Some((r, table)) = &self.mask {
+            let i = table.integrate(&texel_polygon(scene, frame, piece, r, table.size()));
+            coverage = i.sum[3] / i.area;
+        }
+        Surface {
+            albedo,
+            coverage: coverage.clamp(0.0, 1.0),
+        }
+    }
+}
+
+/// True when two references read the same texels at the same coordinates.
+fn same_lookup(scene: &Scene, a: &TextureRef, b: &TextureRef) -> bool {
+    let (ta, tb) = (a.of(&scene.textures), b.of(&scene.textures));
+    (a.texture == b.texture || (ta.width, ta.height) == (tb.width, tb.height))
+        && a.transform == b.transform
+        && a.wrap == b.wrap
+}
+
+/// The piece's polygon in texel units of `tex` as `r` maps it.
+fn texel_polygon(
+    scene: &Scene,
+    frame: &Frame,
+    piece: &Piece,
+    r: &TextureRef,
+    [width, height]: [f64; 2],
+) -> Vec<DVec2> {
+    let t = piece.triangle as usize;
+    let tri = scene.triangles[t];
+    let [a, b, c] = tri.map(|v| frame.to_grid(scene.positions[v as usize]));
+    let uv = tri.map(|v| {
+        let m = r.apply(scene.uvs[v as usize]);
+        DVec2::new(m[0] as f64 * width, m[1] as f64 * height)
+    });
+    let (e0, e1) = (b - a, c - a);
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let denom = d00 * d11 - d01 * d01;
+    piece
+        .vertices
+        .iter()
+        .map(|&p| {
+            let e2 = DVec3::from(p) - a;
+            let (d20, d21) = (e2.dot(e0), e2.dot(e1));
+            let beta = (d11 * d20 - d01 * d21) / denom;
+            let gamma = (d00 * d21 - d01 * d20) / denom;
+            uv[0] + (uv[1] - uv[0]) * beta + (uv[2] - uv[0]) * gamma
+        })
+        .collect()
+}
+
+/// A summed-area table of up to four channels over one copy of an image, with its wrap modes.
+pub struct Table {
+    width: i64,
+    height: i64,
+    wrap: [Wrap; 2],
+    /// `(width + 1) · (height + 1)` prefix sums, row-major, 4 channels each.
+    sums: Vec<[f64; 4]>,
+}
+
+/// The integral of a table over a polygon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Integral {
+    /// Σ value × covered area, per channel (texel units²).
+    pub sum: [f64; 4],
+    /// The polygon's area (texel units²).
+    pub area: f64,
+    /// Area of the cells larger than a texel that the polygon's boundary crosses: the error of
+    /// `sum` is at most this times the channel's range.
+    pub bound: f64,
+}
+
+impl Table {
+    /// The table of `value(texel)` (up to four channels) over `tex`, repeating.
+    pub fn new(tex: &Texture, value: impl Fn([u8; 4]) -> [f64; 4] + Sync) -> Self {
+        let (w, h) = (tex.width as usize, tex.height as usize);
+        let rows: Vec<Vec<[f64; 4]>> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let mut acc = [0.0; 4];
+                let mut row = vec![[0.0; 4]; w + 1];
+                for x in 0..w {
+                    let v = value(tex.texel(x as i64, y as i64, [Wrap::Repeat; 2]));
+                    for (s, v) in acc.iter_mut().zip(v) {
+                        *s += v;
+                    }
+                    row[x + 1] = acc;
+                }
+                row
+            })
+            .collect();
+        let mut sums = vec![[0.0; 4]; (w + 1) * (h + 1)];
+        for y in 0..h {
+            for x in 0..=w {
+                let above = sums[y * (w + 1) + x];
+                sums[(y + 1) * (w + 1) + x] = std::array::from_fn(|c| above[c] + rows[y][x][c]);
+            }
+        }
+        Table {
+            width: w as i64,
+            height: h as i64,
+            wrap: [Wrap::Repeat; 2],
+            sums,
+        }
+    }
+
+    /// Width and height of the image, in texels.
+    pub fn size(&self) -> [f64; 2] {
+        [self.width as f64, self.height as f64]
+    }
+
+    /// The same table read with other wrap modes.
+    pub fn with_wrap(mut self, wrap: [Wrap; 2]) -> Self {
+        self.wrap = wrap;
+        self
+    }
+
+    /// Sum over texels `[x0, x1) × [y0, y1)` of the image itself (no wrapping).
+    fn base_sum(&self, x0: i64, x1: i64, y0: i64, y1: i64) -> [f64; 4] {
+        let w = self.width as usize + 1;
+        let at = |x: i64, y: i64| self.sums[y as usize * w + x as usize];
+        let (a, b, c, d) = (at(x1, y1), at(x0, y1), at(x1, y0), at(x0, y0));
+        std::array::from_fn(|k| a[k] - b[k] - c[k] + d[k])
+    }
+
+    /// Sum over texels `[x0, x1) × [y0, y1)` of the wrapped (unbounded) texture.
+    pub fn rect_sum(&self, x0: i64, x1: i64, y0: i64, y1: i64) -> [f64; 4] {
+        let (mut xs, mut ys) = (Vec::new(), Vec::new());
+        segments(x0, x1, self.width, self.wrap[0], &mut xs);
+        segments(y0, y1, self.height, self.wrap[1], &mut ys);
+        let mut out = [0.0; 4];
+        for &(a, b, kx) in &xs {
+            for &(c, d, ky) in &ys {
+                let s = self.base_sum(a, b, c, d);
+                for k in 0..4 {
+                    out[k] += kx * ky * s[k];
+                }
+            }
+        }
+        out
+    }
+
+    /// The integral over a polygon in texel units (either winding). A polygon of no area (all
+    /// its texture coordinates on a line) reads the texel under its first vertex, as if it
+    /// covered exactly that texel.
+    pub fn integrate(&self, poly: &[DVec2]) -> Integral {
+        let area = shoelace(poly).abs();
+        let lo = poly.iter().fold(DVec2::INFINITY, |a, &p| a.min(p));
+        let hi = poly.iter().fold(DVec2::NEG_INFINITY, |a, &p| a.max(p));
+        if !(area > 1e-12 * (1.0 + (hi - lo).length_squared())) {
+            let p = poly.first().copied().unwrap_or_default().floor();
+            let (x, y) = (p.x as i64, p.y as i64);
+            return Integral {
+                sum: self.rect_sum(x, x + 1, y, y + 1),
+                area: 1.0,
+                bound: 0.0,
+            };
+        }
+        let perimeter: f64 = (0..poly.len())
+            .map(|i| (poly[(i + 1) % poly.len()] - poly[i]).length())
+            .sum();
+        let min_cell = (perimeter / MAX_BOUNDARY_CELLS).max(1.0);
+        let rect = [lo.x.floor() as i64, hi.x.ceil() as i64, lo.y.floor() as i64, hi.y.ceil() as i64];
+        let rect = [rect[0], rect[1].max(rect[0] + 1), rect[2], rect[3].max(rect[2] + 1)];
+        let mut acc = Integral {
+            sum: [0.0; 4],
+            area,
+            bound: 0.0,
+        };
+        self.cell(poly.to_vec(), rect, min_cell, &mut acc);
+        acc
+    }
+
+    fn cell(&self, poly: Vec<DVec2>, [x0, x1, y0, y1]: [i64; 4], min_cell: f64, acc: &mut Integral) {
+        let poly = clip_rect(poly, [x0 as f64, x1 as f64, y0 as f64, y1 as f64]);
+        let covered = shoelace(&poly).abs();
+        if covered <= 0.0 {
+            return;
+        }
+        let (w, h) = (x1 - x0, y1 - y0);
+        let cell_area = (w * h) as f64;
+        let full = covered >= cell_area * (1.0 - 1e-12);
+        if full || (w as f64) <= min_cell && (h as f64) <= min_cell {
+            let s = self.rect_sum(x0, x1, y0, y1);
+            let weight = if full { 1.0 } else { covered / cell_area };
+            for k in 0..4 {
+                acc.sum[k] += weight * s[k];
+            }
+            if !full && cell_area > 1.0 {
+                acc.bound += cell_area;
+            }
+            return;
+        }
+        if w >= h {
+            let m = x0 + w / 2;
+            self.cell(poly.clone(), [x0, m, y0, y1], min_cell, acc);
+            self.cell(poly, [m, x1, y0, y1], min_cell, acc);
+        } else {
+            let m = y0 + h / 2;
+            self.cell(poly.clone(), [x0, x1, y0, m], min_cell, acc);
+            self.cell(poly, [x0, x1, m, y1], min_cell, acc);
+        }
+    }
+}
+
+/// Split `[a, b)` along an axis of `n` texels into ranges of the image `[lo, hi) ⊆ [0, n)`, each
+/// read `count` times, by the wrap mode.
+fn segments(a: i64, b: i64, n: i64, wrap: Wrap, out: &mut Vec<(i64, i64, f64)>) {
+    match wrap {
+        Wrap::ClampToEdge => {
+            if a < 0 {
+                out.push((0, 1, (b.min(0) - a) as f64));
+            }
+            let (lo, hi) = (a.max(0), b.min(n));
+            if lo < hi {
+                out.push((lo, hi, 1.0));
+            }
+            if b > n {
+                out.push((n - 1, n, (b - a.max(n)) as f64));
+            }
+        }
+        Wrap::Repeat | Wrap::MirroredRepeat => {
+            let mirrored = wrap == Wrap::MirroredRepeat;
+            let period = if mirrored { 2 * n } else { n };
+            let mut x = a;
+            while x < b {
+                if x.rem_euclid(period) == 0 && b - x >= period {
+                    let k = (b - x) / period;
+                    out.push((0, n, if mirrored { 2 * k } else { k } as f64));
+                    x += k * period;
+                    continue;
+                }
+                let q = x.div_euclid(n);
+                let r = x - q * n;
+                let end = b.min((q + 1) * n);
+                let len = end - x;
+                if mirrored && q.rem_euclid(2) == 1 {
+                    out.push((n - r - len, n - r, 1.0));
+                } else {
+                    out.push((r, r + len, 1.0));
+                }
+                x = end;
+            }
+        }
+    }
+}
+
+/// Signed area of a polygon.
+fn shoelace(poly: &[DVec2]) -> f64 {
+    let n = poly.len();
+    0.5 * (0..n).map(|i| poly[i].perp_dot(poly[(i + 1) % n])).sum::<f64>()
+}
+
+/// Sutherland–Hodgman clip of a polygon to the rectangle `[x0, x1] × [y0, y1]`.
+fn clip_rect(mut poly: Vec<DVec2>, [x0, x1, y0, y1]: [f64; 4]) -> Vec<DVec2> {
+    let planes: [(usize, f64, f64); 4] = [(0, x0, 1.0), (0, x1, -1.0), (1, y0, 1.0), (1, y1, -1.0)];
+    for (axis, at, sign) in planes {
+        if poly.is_empty() {
+            break;
+        }
+        let inside = |p: DVec2| sign * (p[axis] - at) >= 0.0;
+        let mut out = Vec::with_capacity(poly.len() + 2);
+        for i in 0..poly.len() {
+            let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+            let (pin, qin) = (inside(p), inside(q));
+            if pin {
+                out.push(p);
+            }
+            if pin != qin {
+                let t = (at - p[axis]) / (q[axis] - p[axis]);
+                let mut x = p + (q - p) * t;
+                x[axis] = at;
+                out.push(x);
+            }
+        }
+        poly = out;
+    }
+    poly
+}
