@@ -7,11 +7,13 @@
 //!   triangles;
 //! - [`wide_bvh`]: the 8-wide BVH built from it and its traversal;
 //! - [`wide_node`]: one node (Embree's BVH8 layout) and its slab test of all eight children;
+//! - [`alpha`]: alpha-masked triangles (a ray passes through cut-out texels);
 //! - [`watertight`]: watertight ray/triangle tests (Woop, Benthin and Wald 2013), one at a time
 //!   or four in SSE lanes with the same operations.
 
 use glam::{DVec3, Vec3};
 
+pub mod alpha;
 pub mod visibility;
 pub mod watertight;
 pub mod wide_bvh;

@@ -6,9 +6,12 @@
 //! with leaves of up to four triangles, and [`WideBvh`] gives it exact f32 child boxes and
 //! traverses it with AVX2 slab tests (wide_bvh.rs).
 //! Triangles are tested with a watertight intersection (no rays lost through shared edges).
+//! Alpha-masked triangles stop a ray only where their mask is opaque ([`crate::raytrace::alpha`]);
+//! leaves holding one are tested lane by lane, all others four lanes at once.
 //! Rays start `BACKOFF` behind their origin (see there). The closest hit is order-independent:
 //! of two hits at the same distance (a shared edge) the lower leaf slot wins.
 
+use crate::raytrace::alpha::{AlphaMasks, Cutout, MaskedTriangle};
 use crate::raytrace::watertight::{TriangleBlocks, Watertight};
 use crate::raytrace::wide_bvh::{AnyLeaf, ClosestLeaf, WideBvh};
 use crate::raytrace::wide_collapse;
@@ -32,6 +35,11 @@ pub struct Visibility {
     blocks: TriangleBlocks,
     /// Scene triangle index and unit geometric normal (counter-clockwise winding) of each slot.
     info: Vec<SlotInfo>,
+    /// The scene's alpha masks and the masked triangles (`SlotInfo::mask` indexes them);
+    /// None when no triangle is masked.
+    alpha: Option<(AlphaMasks, Vec<MaskedTriangle>)>,
+    /// Per leaf: true when one of its slots is masked.
+    leaf_masked: Vec<bool>,
     /// Smallest ray parameter accepted, in grid units (above f32 self-intersection noise).
     pub epsilon: f32,
 }
@@ -76,6 +84,25 @@ impl Visibility {
         extent: f64,
         params: BvhBuildParams,
     ) -> Self {
+        // Triangles cut out everywhere are not there for light.
+        let masks = AlphaMasks::new(scene);
+        let triangles: Vec<u32> = triangles
+            .iter()
+            .copied()
+            .filter(|&t| masks.cutout(scene, t as usize) != Cutout::Everywhere)
+            .collect();
+        let mut masked = Vec::new();
+        let mask_of: Vec<u32> = triangles
+            .iter()
+            .map(|&t| match masks.cutout(scene, t as usize) {
+                Cutout::Masked(image) => {
+                    let uv = masks.corner_uvs(scene, t as usize);
+                    masked.push(MaskedTriangle { image, uv });
+                    masked.len() as u32 - 1
+                }
+                _ => NO_MASK,
+            })
+            .collect();
         let tris: Vec<Triangle> = triangles
             .iter()
             .map(|&t| {
@@ -112,6 +139,7 @@ impl Visibility {
         });
         let mut blocks = TriangleBlocks::default();
         let mut info = Vec::with_capacity(4 * bvh.leaves().len());
+        let mut leaf_masked = Vec::with_capacity(bvh.leaves().len());
         for &(first, count) in bvh.leaves() {
             let ks = &order[first as usize..(first + count) as usize];
             let leaf: Vec<[Vec3A; 3]> = ks
@@ -122,11 +150,13 @@ impl Visibility {
                 })
                 .collect();
             blocks.push(&leaf);
+            leaf_masked.push(ks.iter().any(|&k| mask_of[k as usize] != NO_MASK));
             info.extend((0..4).map(|lane| {
                 let k = ks[lane.min(ks.len() - 1)] as usize;
                 SlotInfo {
                     normal: normals[k].to_array(),
                     triangle: triangles[k],
+                    mask: mask_of[k],
                 }
             }));
         }
@@ -134,8 +164,10 @@ impl Visibility {
             bvh,
             blocks,
             info,
+            alpha: (!masked.is_empty()).then_some((masks, masked)),
+            leaf_masked,
             tris,
-            ids: triangles.to_vec(),
+            ids: triangles,
             epsilon: ray_epsilon(extent),
         }
     }
@@ -173,6 +205,7 @@ impl Visibility {
         let mut leaf = Closest {
             vis: self,
             wt: &wt,
+            start: ray.start,
             d: ray.dir,
             best: u32::MAX,
         };
@@ -216,7 +249,7 @@ impl Visibility {
         let (mut best, mut tmax) = (u32::MAX, f32::INFINITY);
         for (s, tri) in self.all_slots() {
             let t = wt.intersect(&tri, BACKOFF, tmax);
-            if self.counts(s, t, d) && t < tmax {
+            if self.counts(s, t, d) && t < tmax && self.opaque(s, &tri, start + d * t) {
                 (best, tmax) = (s, t);
             }
         }
@@ -231,8 +264,26 @@ impl Visibility {
     /// [`Visibility::trace_occluded`] by testing every triangle slot with the scalar test.
     pub fn trace_occluded_brute_force(&self, ray: &Ray) -> bool {
         let wt = Watertight::new(ray.start, ray.dir);
-        self.all_slots()
-            .any(|(s, tri)| self.counts(s, wt.intersect(&tri, BACKOFF, ray.tmax), ray.dir))
+        self.all_slots().any(|(s, tri)| {
+            let t = wt.intersect(&tri, BACKOFF, ray.tmax);
+            self.counts(s, t, ray.dir) && self.opaque(s, &tri, ray.start + ray.dir * t)
+        })
+    }
+
+    /// True when slot `s` (triangle `tri`) is opaque at the point `p` a ray hit.
+    #[inline(always)]
+    fn opaque(&self, s: u32, tri: &[Vec3A; 3], p: Vec3A) -> bool {
+        let mask = self.info[s as usize].mask;
+        match &self.alpha {
+            Some((masks, masked)) if mask != NO_MASK => masked[mask as usize].opaque_at(masks, tri, p),
+            _ => true,
+        }
+    }
+
+    /// True when leaf `leaf` holds a masked triangle.
+    #[inline(always)]
+    fn leaf_masked(&self, leaf: u32) -> bool {
+        self.alpha.is_some() && self.leaf_masked[leaf as usize]
     }
 
     /// Whether a distance `t` of the watertight test (from the start `BACKOFF` behind the
@@ -263,6 +314,7 @@ impl Visibility {
         let mut leaf = Occluding {
             vis: self,
             wt: &wt,
+            start: ray.start,
             d: ray.dir,
             tmax: ray.tmax,
         };
@@ -274,6 +326,7 @@ impl Visibility {
 struct Occluding<'a> {
     vis: &'a Visibility,
     wt: &'a Watertight,
+    start: Vec3A,
     d: Vec3A,
     tmax: f32,
 }
@@ -288,6 +341,13 @@ impl AnyLeaf for Occluding<'_> {
             (BACKOFF, self.tmax),
             self.vis.epsilon,
         );
+        if self.vis.leaf_masked(leaf) {
+            return (0..count as usize).any(|k| {
+                let (s, t) = (4 * leaf + k as u32, lanes.ts[k]);
+                let tri = self.vis.blocks.triangle(leaf as usize, k);
+                self.vis.counts(s, t, self.d) && self.vis.opaque(s, &tri, self.start + self.d * t)
+            });
+        }
         // A hit beyond the epsilon stops the ray ([`Visibility::counts`]); only a nearer one
         // needs its normal.
         if lanes.hit & !lanes.near != 0 {
@@ -304,6 +364,7 @@ impl AnyLeaf for Occluding<'_> {
 struct Closest<'a> {
     vis: &'a Visibility,
     wt: &'a Watertight,
+    start: Vec3A,
     d: Vec3A,
     best: u32,
 }
@@ -318,7 +379,8 @@ impl ClosestLeaf for Closest<'_> {
             (BACKOFF, tmax),
             self.vis.epsilon,
         );
-        if lanes.near == 0 {
+        let masked = self.vis.leaf_masked(leaf);
+        if lanes.near == 0 && !masked {
             let (t, lane) = lanes.nearest;
             // Every hit lies beyond the epsilon and counts ([`Visibility::counts`]); distances
             // are at most `tmax`, so the nearest lane wins unless it ties a lower slot.
@@ -334,6 +396,12 @@ impl ClosestLeaf for Closest<'_> {
             if !self.vis.counts(s, t, self.d) {
                 continue;
             }
+            if masked {
+                let tri = self.vis.blocks.triangle(leaf as usize, k);
+                if !self.vis.opaque(s, &tri, self.start + self.d * t) {
+                    continue;
+                }
+            }
             if t < tmax || (t == tmax && s < self.best) {
                 tmax = t;
                 self.best = s;
@@ -343,11 +411,16 @@ impl ClosestLeaf for Closest<'_> {
     }
 }
 
-/// What a hit on a slot reports: the scene triangle and its unit normal.
+/// What a hit on a slot reports: the scene triangle and its unit normal; and its mask.
 struct SlotInfo {
     normal: [f32; 3],
     triangle: u32,
+    /// Index of its [`MaskedTriangle`], or [`NO_MASK`].
+    mask: u32,
 }
+
+/// [`SlotInfo::mask`] of an opaque triangle.
+const NO_MASK: u32 = u32::MAX;
 
 /// A ray as the tracer takes it, in f32 grid coordinates: its start `BACKOFF` behind the
 /// caller's origin, its unit direction, and the far end of the segment (from the start) for an

@@ -11,6 +11,7 @@ mod fixtures;
 mod room_light;
 
 mod adaptive;
+mod alpha;
 mod export_gltf;
 mod formfactors;
 mod locate;
