@@ -69,13 +69,15 @@ impl FrameSettings {
 /// emitter lying in a wall (the Cornell box light in its ceiling) is what the eye sees.
 pub const EMITTER_LIFT: f32 = 1e-4;
 
-/// Per-corner vertex data (3 per triangle): position, face normal, albedo, emission — 12 floats
-/// each, the layout of the GPU vertex buffer. Degenerate triangles get the normal +y; emissive
+/// Per-corner vertex data (3 per triangle): position, face normal, albedo (the material's mean
+/// over its texture, [`Scene::mean_albedo`]), emission — 12 floats each, the layout of the GPU
+/// vertex buffer. Degenerate triangles get the normal +y; emissive
 /// triangles are lifted by [`EMITTER_LIFT`] × the scene diagonal along their normal.
 pub fn corner_vertices(scene: &Scene) -> Vec<f32> {
     let (lo, hi) = scene.bounds();
     let lift = EMITTER_LIFT * (hi - lo).length();
     let mut out = Vec::with_capacity(scene.triangles.len() * 36);
+    let albedos = scene.mean_albedos();
     for t in 0..scene.triangles.len() {
         let [a, b, c] = scene.corners(t);
         let n = (b - a).cross(c - a).normalize_or(Vec3::Y);
@@ -88,7 +90,7 @@ pub fn corner_vertices(scene: &Scene) -> Vec<f32> {
         for p in [a + offset, b + offset, c + offset] {
             out.extend_from_slice(&p.to_array());
             out.extend_from_slice(&n.to_array());
-            out.extend_from_slice(&m.albedo);
+            out.extend_from_slice(&albedos[scene.triangle_material[t] as usize]);
             out.extend_from_slice(&m.emission);
         }
     }

@@ -252,12 +252,14 @@ impl Table {
 
     /// Sum over texels `[x0, x1) × [y0, y1)` of the wrapped (unbounded) texture.
     pub fn rect_sum(&self, x0: i64, x1: i64, y0: i64, y1: i64) -> [f64; 4] {
-        let (mut xs, mut ys) = (Vec::new(), Vec::new());
-        segments(x0, x1, self.width, self.wrap[0], &mut xs);
-        segments(y0, y1, self.height, self.wrap[1], &mut ys);
+        if x0 >= 0 && x1 <= self.width && y0 >= 0 && y1 <= self.height {
+            return self.base_sum(x0, x1, y0, y1);
+        }
+        let xs = segments(x0, x1, self.width, self.wrap[0]);
+        let ys = segments(y0, y1, self.height, self.wrap[1]);
         let mut out = [0.0; 4];
-        for &(a, b, kx) in &xs {
-            for &(c, d, ky) in &ys {
+        for &(a, b, kx) in xs.as_slice() {
+            for &(c, d, ky) in ys.as_slice() {
                 let s = self.base_sum(a, b, c, d);
                 for k in 0..4 {
                     out[k] += kx * ky * s[k];
@@ -330,20 +332,42 @@ impl Table {
     }
 }
 
+/// Up to eight ranges of an image axis, each with how many times it is read.
+struct Segments {
+    items: [(i64, i64, f64); 8],
+    len: usize,
+}
+
+impl Segments {
+    fn push(&mut self, lo: i64, hi: i64, count: f64) {
+        self.items[self.len] = (lo, hi, count);
+        self.len += 1;
+    }
+
+    fn as_slice(&self) -> &[(i64, i64, f64)] {
+        &self.items[..self.len]
+    }
+}
+
 /// Split `[a, b)` along an axis of `n` texels into ranges of the image `[lo, hi) ⊆ [0, n)`, each
-/// read `count` times, by the wrap mode.
-fn segments(a: i64, b: i64, n: i64, wrap: Wrap, out: &mut Vec<(i64, i64, f64)>) {
+/// read `count` times, by the wrap mode. Repeat gives at most 3 ranges (a head, whole copies, a
+/// tail) and mirrored repeat at most 6, so eight always suffice.
+fn segments(a: i64, b: i64, n: i64, wrap: Wrap) -> Segments {
+    let mut out = Segments {
+        items: [(0, 0, 0.0); 8],
+        len: 0,
+    };
     match wrap {
         Wrap::ClampToEdge => {
             if a < 0 {
-                out.push((0, 1, (b.min(0) - a) as f64));
+                out.push(0, 1, (b.min(0) - a) as f64);
             }
             let (lo, hi) = (a.max(0), b.min(n));
             if lo < hi {
-                out.push((lo, hi, 1.0));
+                out.push(lo, hi, 1.0);
             }
             if b > n {
-                out.push((n - 1, n, (b - a.max(n)) as f64));
+                out.push(n - 1, n, (b - a.max(n)) as f64);
             }
         }
         Wrap::Repeat | Wrap::MirroredRepeat => {
@@ -353,7 +377,7 @@ fn segments(a: i64, b: i64, n: i64, wrap: Wrap, out: &mut Vec<(i64, i64, f64)>) 
             while x < b {
                 if x.rem_euclid(period) == 0 && b - x >= period {
                     let k = (b - x) / period;
-                    out.push((0, n, if mirrored { 2 * k } else { k } as f64));
+                    out.push(0, n, if mirrored { 2 * k } else { k } as f64);
                     x += k * period;
                     continue;
                 }
@@ -362,14 +386,15 @@ fn segments(a: i64, b: i64, n: i64, wrap: Wrap, out: &mut Vec<(i64, i64, f64)>) 
                 let end = b.min((q + 1) * n);
                 let len = end - x;
                 if mirrored && q.rem_euclid(2) == 1 {
-                    out.push((n - r - len, n - r, 1.0));
+                    out.push(n - r - len, n - r, 1.0);
                 } else {
-                    out.push((r, r + len, 1.0));
+                    out.push(r, r + len, 1.0);
                 }
                 x = end;
             }
         }
     }
+    out
 }
 
 /// Signed area of a polygon.
