@@ -275,7 +275,9 @@ impl Visibility {
     fn opaque(&self, s: u32, tri: &[Vec3A; 3], p: Vec3A) -> bool {
         let mask = self.info[s as usize].mask;
         match &self.alpha {
-            Some((masks, masked)) if mask != NO_MASK => masked[mask as usize].opaque_at(masks, tri, p),
+            Some((masks, masked)) if mask != NO_MASK => {
+                masked[mask as usize].opaque_at(masks, tri, p)
+            }
             _ => true,
         }
     }

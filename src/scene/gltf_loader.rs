@@ -43,7 +43,9 @@ fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
                     Some(id) => id,
                     None => {
                         let name = format!("{}#image {source}", path.display());
-                        scene.textures.push(texture_of(path, name, &images[source])?);
+                        scene
+                            .textures
+                            .push(texture_of(path, name, &images[source])?);
                         let id = (scene.textures.len() - 1) as u32;
                         image_ids[source] = Some(id);
                         id
@@ -158,10 +160,14 @@ fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
                 };
                 let mut material = match prim.material().index() {
                     Some(i) => material_ids[i],
-                    None => scene.material_index(Material::plain("gltf-default", [1.0; 3], [0.0; 3])),
+                    None => {
+                        scene.material_index(Material::plain("gltf-default", [1.0; 3], [0.0; 3]))
+                    }
                 };
                 let set = prim.material().index().and_then(|i| uv_sets[i]);
-                let coords = set.and_then(|s| reader.read_tex_coords(s)).map(|t| t.into_f32());
+                let coords = set
+                    .and_then(|s| reader.read_tex_coords(s))
+                    .map(|t| t.into_f32());
                 match coords {
                     Some(t) => {
                         uvs.resize(base as usize, [0.0; 2]);
@@ -333,7 +339,10 @@ fn texture_of(path: &Path, name: String, image: &gltf::image::Data) -> Result<Te
     if image.pixels.len() != n * texel {
         return Err(Error::input(
             path,
-            format!("image `{name}` holds {} bytes for {n} texels", image.pixels.len()),
+            format!(
+                "image `{name}` holds {} bytes for {n} texels",
+                image.pixels.len()
+            ),
         ));
     }
     let value = |px: &[u8], ch: usize, colour: bool| -> u8 {
@@ -342,7 +351,11 @@ fn texture_of(path: &Path, name: String, image: &gltf::image::Data) -> Result<Te
             2 => (u16::from_le_bytes([px[2 * ch], px[2 * ch + 1]]) as f32 / 257.0).round() as u8,
             _ => {
                 let v = f32::from_le_bytes(px[4 * ch..4 * ch + 4].try_into().unwrap());
-                let v = if colour { super::texture::linear_to_srgb(v.max(0.0)) } else { v };
+                let v = if colour {
+                    super::texture::linear_to_srgb(v.max(0.0))
+                } else {
+                    v
+                };
                 (v.clamp(0.0, 1.0) * 255.0).round() as u8
             }
         }

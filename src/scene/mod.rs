@@ -260,7 +260,11 @@ impl Scene {
                 self.positions.len()
             )));
         }
-        if let Some(i) = self.uvs.iter().position(|t| t.iter().any(|c| !c.is_finite())) {
+        if let Some(i) = self
+            .uvs
+            .iter()
+            .position(|t| t.iter().any(|c| !c.is_finite()))
+        {
             return Err(Error::input(
                 path,
                 format!(
@@ -298,10 +302,11 @@ impl Scene {
     /// Texture references of `m` point at textures that exist, with finite transforms, and its
     /// alpha factor and cutoff are finite numbers.
     fn validate_textures(&self, path: &Path, m: &Material) -> Result<()> {
-        let refs = m
-            .albedo_texture
-            .iter()
-            .chain(m.alpha.iter().flat_map(|a| a.texture.as_ref().map(|t| &t.0)));
+        let refs = m.albedo_texture.iter().chain(
+            m.alpha
+                .iter()
+                .flat_map(|a| a.texture.as_ref().map(|t| &t.0)),
+        );
         for r in refs {
             if r.texture as usize >= self.textures.len() {
                 return Err(Error::Internal(format!(
@@ -413,8 +418,7 @@ impl Scene {
         self.materials.iter().all(|m| {
             m.albedo[0] == m.albedo[1]
                 && m.albedo[1] == m.albedo[2]
-                && m
-                    .albedo_texture
+                && m.albedo_texture
                     .as_ref()
                     .is_none_or(|t| t.of(&self.textures).is_grey())
         })

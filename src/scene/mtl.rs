@@ -170,7 +170,8 @@ mod tests {
 
     #[test]
     fn options_before_the_file_name() {
-        let st = parse_statement("-s 2 3 1 -o 0.5 0.25 -bm 0.3 -clamp on textures\\a b.png").unwrap();
+        let st =
+            parse_statement("-s 2 3 1 -o 0.5 0.25 -bm 0.3 -clamp on textures\\a b.png").unwrap();
         assert_eq!(st.file, "textures/a b.png");
         assert_eq!(st.scale, [2.0, 3.0]);
         assert_eq!(st.offset, [0.5, 0.25]);
@@ -184,9 +185,13 @@ mod tests {
     #[test]
     fn bad_statements_say_what_is_wrong() {
         assert!(parse_statement("-s").unwrap_err().contains("needs 1"));
-        assert!(parse_statement("-zz 1 a.png").unwrap_err().contains("unknown"));
+        assert!(parse_statement("-zz 1 a.png")
+            .unwrap_err()
+            .contains("unknown"));
         assert!(parse_statement("-s 1 1").unwrap_err().contains("no file"));
-        assert!(parse_statement("-imfchan q a.png").unwrap_err().contains("imfchan"));
+        assert!(parse_statement("-imfchan q a.png")
+            .unwrap_err()
+            .contains("imfchan"));
     }
 
     #[test]

@@ -135,13 +135,14 @@ fn material(
     files: &mut TextureFiles,
     warnings: &mut LoadWarnings,
 ) -> Result<Material> {
-    let mut statement = |key: &str, value: &Option<String>| -> Result<Option<(TextureStatement, u32)>> {
-        let Some(value) = value else { return Ok(None) };
-        let st = mtl::parse_statement(value).map_err(|e| {
-            Error::input(obj, format!("material `{}`: `{key} {value}`: {e}", m.name))
-        })?;
-        Ok(files.find(dir, &st, warnings).map(|index| (st, index)))
-    };
+    let mut statement =
+        |key: &str, value: &Option<String>| -> Result<Option<(TextureStatement, u32)>> {
+            let Some(value) = value else { return Ok(None) };
+            let st = mtl::parse_statement(value).map_err(|e| {
+                Error::input(obj, format!("material `{}`: `{key} {value}`: {e}", m.name))
+            })?;
+            Ok(files.find(dir, &st, warnings).map(|index| (st, index)))
+        };
     let albedo_texture = statement("map_Kd", &m.diffuse_texture)?.map(|(st, i)| st.reference(i));
     let mask = statement("map_d", &m.dissolve_texture)?.map(|(st, i)| {
         let channel = st.channel.unwrap_or(Channel::Luminance);
@@ -173,7 +174,12 @@ struct TextureFiles {
 
 impl TextureFiles {
     /// The index of the file `st` names (warning when it is missing, or found with another case).
-    fn find(&mut self, dir: &Path, st: &TextureStatement, warnings: &mut LoadWarnings) -> Option<u32> {
+    fn find(
+        &mut self,
+        dir: &Path,
+        st: &TextureStatement,
+        warnings: &mut LoadWarnings,
+    ) -> Option<u32> {
         let path = match self.found.get(&st.file) {
             Some(p) => p.clone(),
             None => match mtl::resolve(dir, &st.file) {

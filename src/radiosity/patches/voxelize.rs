@@ -170,7 +170,8 @@ pub fn voxelize_noting(
     let surfaces = albedo::piece_surfaces(scene, &frame, &pieces);
     for (key, members) in groups {
         let cut = Cut::Textured(&surfaces);
-        if let Some(patch) = build_patch(scene, &frame, key, dims, &members, &pieces, cut, &mut set) {
+        if let Some(patch) = build_patch(scene, &frame, key, dims, &members, &pieces, cut, &mut set)
+        {
             set.patches.push(patch);
         }
     }
@@ -283,7 +284,9 @@ fn coarse_light(
     let means = scene.mean_albedos();
     for c in cells {
         let cut = Cut::MaterialMeans(&means);
-        if let Some(patch) = build_patch(scene, frame, c.key, dims, &c.members, pieces, cut, &mut set) {
+        if let Some(patch) =
+            build_patch(scene, frame, c.key, dims, &c.members, pieces, cut, &mut set)
+        {
             set.patches.push(patch);
         }
     }
