@@ -21,6 +21,8 @@ pub struct PlanState {
     pub resident_bytes: u64,
     /// Triangles of a scene input.
     pub triangles: u64,
+    /// Texels of the largest texture of a scene input (0 when untextured).
+    pub largest_texture_texels: u64,
     /// Width and height of a height-map input.
     pub map_size: (u64, u64),
     /// Estimated patch count after voxelisation.

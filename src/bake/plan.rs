@@ -76,7 +76,14 @@ impl PlanInput {
                 let t = scene.triangles.len() as u64;
                 state.triangles = t;
                 state.channels = if scene.is_grey() { 1 } else { 3 };
-                let bytes = v * 12 + t * 20 + scene.materials.len() as u64 * 64;
+                let texels = |x: &crate::scene::texture::Texture| x.width as u64 * x.height as u64;
+                state.largest_texture_texels = scene.textures.iter().map(texels).max().unwrap_or(0);
+                let texture_bytes: u64 = scene.textures.iter().map(|x| 4 * texels(x)).sum();
+                let bytes = v * 12
+                    + t * 20
+                    + scene.materials.len() as u64 * 64
+                    + scene.uvs.len() as u64 * 8
+                    + texture_bytes;
                 state.resident_bytes = bytes;
                 PlannedStage {
                     stage: "load".into(),

@@ -220,11 +220,13 @@ impl Table {
     /// The table of `value(texel)` (up to four channels) over `tex`, repeating.
     pub fn new(tex: &Texture, value: impl Fn([u8; 4]) -> [f64; 4] + Sync) -> Self {
         let (w, h) = (tex.width as usize, tex.height as usize);
-        let rows: Vec<Vec<[f64; 4]>> = (0..h)
-            .into_par_iter()
-            .map(|y| {
+        // Row prefix sums in parallel, then each row adds the one above (32 bytes per texel).
+        let mut sums = vec![[0.0; 4]; (w + 1) * (h + 1)];
+        sums[w + 1..]
+            .par_chunks_mut(w + 1)
+            .enumerate()
+            .for_each(|(y, row)| {
                 let mut acc = [0.0; 4];
-                let mut row = vec![[0.0; 4]; w + 1];
                 for x in 0..w {
                     let v = value(tex.texel(x as i64, y as i64, [Wrap::Repeat; 2]));
                     for (s, v) in acc.iter_mut().zip(v) {
@@ -232,14 +234,14 @@ impl Table {
                     }
                     row[x + 1] = acc;
                 }
-                row
-            })
-            .collect();
-        let mut sums = vec![[0.0; 4]; (w + 1) * (h + 1)];
-        for y in 0..h {
-            for x in 0..=w {
-                let above = sums[y * (w + 1) + x];
-                sums[(y + 1) * (w + 1) + x] = std::array::from_fn(|c| above[c] + rows[y][x][c]);
+            });
+        for y in 1..h {
+            let (above, below) = sums.split_at_mut((y + 1) * (w + 1));
+            let prev = &above[y * (w + 1)..];
+            for (b, a) in below[..w + 1].iter_mut().zip(prev) {
+                for k in 0..4 {
+                    b[k] += a[k];
+                }
             }
         }
         Table {
