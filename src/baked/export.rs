@@ -127,7 +127,20 @@ pub fn export_objects(
     out: &Path,
 ) -> Result<Vec<crate::radiosity::mesh::objects::ObjectLight>> {
     let lit = super::gltf::lit_patches(dir, setup)?;
-    let objects = crate::radiosity::mesh::objects::object_light(&lit.scene, &lit.set, &lit.b);
+    let visible = lit.raycast.visible(&lit.gpu_lights);
+    let direct = if setup.settings.direct {
+        crate::render::direct::object_direct(&lit.scene, &lit.gpu_lights, &|l, p, n, to, d| {
+            !setup.settings.shadows || visible(l, p, n, to, d)
+        })
+    } else {
+        vec![[0.0; 3]; lit.scene.objects.len()]
+    };
+    let objects: Vec<_> =
+        crate::radiosity::mesh::objects::object_light(&lit.scene, &lit.set, &lit.b)
+            .into_iter()
+            .zip(direct)
+            .map(|(o, d)| o.with_direct(d))
+            .collect();
     let doc = serde_json::json!({ "transport": lit.transport, "objects": objects });
     let text = serde_json::to_string_pretty(&doc)
         .map_err(|e| Error::Internal(format!("cannot encode JSON: {e}")))?;

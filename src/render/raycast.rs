@@ -21,10 +21,12 @@ pub struct RaycastScene {
 }
 
 impl RaycastScene {
-    /// Build the BVH over the same (lifted) corner positions the GPU draws.
+    /// Build the BVH over the same (lifted) corner positions the GPU draws; alpha-masked
+    /// materials keep their masks, so shadow rays pass through cut-out texels.
     pub fn new(scene: &Scene) -> Self {
         let verts = corner_vertices(scene);
         let corners = verts.len() / 12;
+        let masked = scene.materials.iter().any(|m| m.alpha.is_some());
         let flat = Scene {
             positions: (0..corners)
                 .map(|k| [verts[12 * k], verts[12 * k + 1], verts[12 * k + 2]])
@@ -32,10 +34,32 @@ impl RaycastScene {
             triangles: (0..corners as u32 / 3)
                 .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
                 .collect(),
-            triangle_material: vec![0; corners / 3],
+            triangle_material: if masked {
+                scene.triangle_material.clone()
+            } else {
+                vec![0; corners / 3]
+            },
             triangle_object: vec![0; corners / 3],
             objects: vec!["all".into()],
-            materials: vec![Material::default_grey()],
+            materials: if masked {
+                scene.materials.clone()
+            } else {
+                vec![Material::default_grey()]
+            },
+            uvs: if masked && !scene.uvs.is_empty() {
+                scene
+                    .triangles
+                    .iter()
+                    .flat_map(|t| t.map(|v| scene.uvs[v as usize]))
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            textures: if masked {
+                scene.textures.clone()
+            } else {
+                Vec::new()
+            },
             ..Default::default()
         };
         let live = flat.live_triangles();

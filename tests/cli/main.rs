@@ -20,6 +20,7 @@ mod killed_bakes;
 mod memory_plan;
 mod resume;
 mod shard;
+mod sponza;
 mod study_cli;
 mod study_objects_cli;
 mod themes_cli;

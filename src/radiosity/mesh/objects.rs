@@ -16,14 +16,23 @@ use crate::radiosity::PatchSet;
 use crate::scene::Scene;
 use serde::Serialize;
 
-/// One object's light.
+/// One object's light. `irradiance` and `irradiance_patches` are the light arriving from other
+/// surfaces (bounced light, and area emitters' light); punctual lights' direct light is
+/// `direct`, and `total` = `direct` + `irradiance` is what a path tracer's irradiance meter on
+/// the object measures.
 #[derive(Clone, Debug, Serialize)]
 pub struct ObjectLight {
     pub name: String,
     /// Total triangle area (scene units²).
     pub area: f64,
-    /// Mean irradiance from the corner interpolation on the display mesh, per channel.
+    /// Mean direct irradiance from the punctual lights, shadowed (0 until
+    /// [`ObjectLight::with_direct`] sets it).
+    pub direct: [f64; 3],
+    /// Mean irradiance from other surfaces (the indirect part): the corner interpolation on
+    /// the display mesh, per channel.
     pub irradiance: [f64; 3],
+    /// `direct` + `irradiance`.
+    pub total: [f64; 3],
     /// Mean irradiance from the patches (area-weighted over each triangle's visible pieces).
     pub irradiance_patches: [f64; 3],
     /// Largest patch irradiance touching the object (0 exactly when no light reaches it).
@@ -39,7 +48,9 @@ pub fn object_light(scene: &Scene, set: &PatchSet, b: &[[f32; 3]]) -> Vec<Object
         .map(|name| ObjectLight {
             name: name.clone(),
             area: 0.0,
+            direct: [0.0; 3],
             irradiance: [0.0; 3],
+            total: [0.0; 3],
             irradiance_patches: [0.0; 3],
             max_patch_irradiance: 0.0,
         })
@@ -91,6 +102,16 @@ pub fn object_light(scene: &Scene, set: &PatchSet, b: &[[f32; 3]]) -> Vec<Object
             o.irradiance[c] /= o.area.max(f64::MIN_POSITIVE);
             o.irradiance_patches[c] /= va.max(f64::MIN_POSITIVE);
         }
+        o.total = o.irradiance;
     }
     out
+}
+
+impl ObjectLight {
+    /// Set the direct part (and the total) from a mean direct irradiance.
+    pub fn with_direct(mut self, direct: [f64; 3]) -> Self {
+        self.direct = direct;
+        self.total = std::array::from_fn(|c| direct[c] + self.irradiance[c]);
+        self
+    }
 }
