@@ -17,6 +17,7 @@ pub type Harness = fn(&[u8]);
 /// The fuzz targets, by name (the `src/bin/` files and `fuzz/corpus/<name>/`).
 pub const TARGETS: &[(&str, Harness)] = &[
     ("scene", scene),
+    ("material", material),
     ("heightmap", heightmap),
     ("text", text),
     ("baked", baked),
@@ -55,6 +56,48 @@ pub fn scene(data: &[u8]) {
     let name = ["scene.obj", "scene.gltf", "scene.glb"][sel as usize % 3];
     let path = file(name, rest);
     let _ = relume::scene::load_scene(&path, relume::scene::SceneOptions::default());
+}
+
+/// Textured materials: with selector 0 the bytes are the MTL beside a fixed textured OBJ (its
+/// texture statements, options and paths; `tex.png` exists), with 1 they are the image a fixed
+/// MTL names as `map_Kd` and `map_d`. A scene that loads is voxelized too, so that its texture
+/// coordinates, transforms and masks reach the albedo integral and the tracer's alpha test.
+pub fn material(data: &[u8]) {
+    let Some((sel, rest)) = split(data) else {
+        return;
+    };
+    let obj = file(
+        "quad.obj",
+        b"mtllib quad.mtl\no quad\nv 0 0 0\nv 0 0 2\nv 2 0 2\nv 2 1 0\n\
+          vt 0 1\nvt 0 0\nvt 3.5 -2\nvt 1 1\nusemtl m\nf 1/1 2/2 3/3 4/4\n",
+    );
+    let dir = obj.parent().expect("scratch folder");
+    // A 2 × 1 RGBA PNG: one opaque texel, one cut out.
+    const PNG: &[u8] = &[
+        0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44,
+        0x52, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x01, 0x08, 0x06, 0x00, 0x00, 0x00, 0xf4,
+        0x22, 0x7f, 0x8a, 0x00, 0x00, 0x00, 0x0f, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0xf8,
+        0xcf, 0xc0, 0xf0, 0x1f, 0x08, 0x19, 0x00, 0x0f, 0xf9, 0x02, 0xfe, 0x2d, 0x47, 0x81, 0xf4,
+        0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82,
+    ];
+    let (mtl, png): (&[u8], &[u8]) = if sel % 2 == 0 {
+        (rest, PNG)
+    } else {
+        (
+            b"newmtl m\nKd 0.8 0.8 0.8\nmap_Kd -s 2 2 tex.png\nmap_d -imfchan m tex.png\n",
+            rest,
+        )
+    };
+    std::fs::write(dir.join("quad.mtl"), mtl).expect("scratch file");
+    std::fs::write(dir.join("tex.png"), png).expect("scratch file");
+    let opts = relume::scene::SceneOptions::default();
+    if let Ok((scene, _)) = relume::scene::load_scene(&obj, opts) {
+        let params = relume::radiosity::patches::voxelize::VoxelizeParams {
+            resolution: relume::radiosity::patches::voxelize::Resolution::VoxelSize(1.0),
+            samples_per_patch: 1,
+        };
+        let _ = relume::radiosity::patches::voxelize::voxelize(&scene, &params);
+    }
 }
 
 /// Every height-map reader (PNG, JPEG, EXR, GeoTIFF, raw f32) through `load_heightmap`, with a

@@ -309,6 +309,22 @@ fn every_file_of_the_corpus_is_used_by_a_case() {
             }
         }
     }
+    // An OBJ's material library and the textures it names are used with it.
+    for name in used.clone() {
+        if name.ends_with(".obj") {
+            let obj = std::fs::read_to_string(corpus_dir().join(&name)).unwrap_or_default();
+            for mtl in obj.lines().filter_map(|l| l.strip_prefix("mtllib ")) {
+                used.insert(mtl.trim().to_string());
+                let text =
+                    std::fs::read_to_string(corpus_dir().join(mtl.trim())).unwrap_or_default();
+                for l in text.lines().filter(|l| l.trim_start().starts_with("map_")) {
+                    if let Some(file) = l.split_whitespace().last() {
+                        used.insert(file.to_string());
+                    }
+                }
+            }
+        }
+    }
     let unused: Vec<String> = list_files(&corpus_dir())
         .into_iter()
         .filter(|f| !used.contains(f))
