@@ -466,3 +466,90 @@ fn albedo_against_material_mean(file: &str, scale: f32, resolution: Resolution) 
     );
     (mean_rel, worst_rel)
 }
+
+/// glTF: `baseColorTexture` with `texCoord` 1, a sampler's wrap modes, `KHR_texture_transform`
+/// (offset, rotation, scale; T·R·S as the extension defines it), `alphaMode` `MASK` with its
+/// cutoff and `BLEND` read as a mask at 0.5, with the factor's alpha.
+#[test]
+fn gltf_texture_coordinates_samplers_transforms_and_alpha_modes() {
+    let tmp = tempfile::tempdir().unwrap();
+    // One triangle per material; TEXCOORD_0 is zero, TEXCOORD_1 carries the coordinates.
+    let pos: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]];
+    let uv1: [[f32; 2]; 3] = [[0.1, 0.2], [0.9, 0.2], [0.1, 0.7]];
+    let mut bin = Vec::new();
+    for p in pos
+        .iter()
+        .flatten()
+        .chain(&[0.0f32; 6])
+        .chain(uv1.iter().flatten())
+    {
+        bin.extend(p.to_le_bytes());
+    }
+    std::fs::write(tmp.path().join("t.bin"), &bin).unwrap();
+    std::fs::write(
+        tmp.path().join("t.png"),
+        png(2, 1, &[[10, 20, 30, 40], [200, 100, 50, 250]]),
+    )
+    .unwrap();
+    let (a, b) = (std::f32::consts::FRAC_PI_2, 0.5f32);
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_texture_transform"],
+        "buffers": [{"uri": "t.bin", "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 24},
+            {"buffer": 0, "byteOffset": 60, "byteLength": 24}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [0, 0, -1], "max": [1, 0, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}],
+        "images": [{"uri": "t.png"}],
+        "samplers": [{"wrapS": 33071, "wrapT": 33648}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "materials": [
+            {"name": "masked", "alphaMode": "MASK", "alphaCutoff": 0.3,
+             "pbrMetallicRoughness": {"baseColorFactor": [0.5, 1, 1, 0.9],
+               "baseColorTexture": {"index": 0, "texCoord": 0, "extensions": {"KHR_texture_transform":
+                 {"offset": [0.25, 0.0], "rotation": a, "scale": [2.0, b], "texCoord": 1}}}}},
+            {"name": "blend", "alphaMode": "BLEND",
+             "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.8]}}],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}, "material": 0},
+            {"attributes": {"POSITION": 0}, "material": 1}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0
+    });
+    let path = tmp.path().join("t.gltf");
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+    let (scene, warnings) = load_scene(&path, SceneOptions::default()).unwrap();
+    assert!(warnings.messages.is_empty(), "{warnings:?}");
+    let masked = scene.materials.iter().find(|m| m.name == "masked").unwrap();
+    let r = masked.albedo_texture.as_ref().unwrap();
+    assert_eq!(r.wrap, [Wrap::ClampToEdge, Wrap::MirroredRepeat]);
+    // T·R·S: rotation by a = π/2 (cos 0, sin 1), scale (2, 0.5), offset (0.25, 0).
+    let want = [[0.0, 0.5, 0.25], [-2.0, 0.0, 0.0]];
+    for (row, w) in r.transform.iter().zip(want) {
+        for (x, y) in row.iter().zip(w) {
+            assert!((x - y).abs() < 1e-6, "{:?}", r.transform);
+        }
+    }
+    let alpha = masked.alpha.as_ref().unwrap();
+    assert_eq!((alpha.factor, alpha.cutoff), (0.9, 0.3));
+    assert_eq!(alpha.texture.as_ref().unwrap().1, Channel::Alpha);
+    // The texture coordinates are TEXCOORD_1's, as the transform asks.
+    assert_eq!(&scene.uvs[..3], &uv1);
+    let blend = scene.materials.iter().find(|m| m.name == "blend").unwrap();
+    let alpha = blend.alpha.as_ref().unwrap();
+    assert_eq!(
+        (alpha.factor, alpha.cutoff, alpha.texture.is_none()),
+        (0.8, 0.5, true)
+    );
+    // The texture stays as stored: RGB sRGB-encoded, alpha linear.
+    assert_eq!(
+        scene.textures[0].texels,
+        vec![10, 20, 30, 40, 200, 100, 50, 250]
+    );
+}
