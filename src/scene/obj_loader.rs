@@ -149,7 +149,7 @@ fn material(
         (st.reference(i), channel)
     });
     let factor = m.dissolve.unwrap_or(1.0);
-    let alpha = (mask.is_some() || factor < 1.0).then(|| AlphaMask {
+    let alpha = (mask.is_some() || factor < 1.0).then_some(AlphaMask {
         factor,
         texture: mask,
         cutoff: 0.5,

@@ -303,7 +303,8 @@ impl Table {
         let area = shoelace(poly).abs();
         let lo = poly.iter().fold(DVec2::INFINITY, |a, &p| a.min(p));
         let hi = poly.iter().fold(DVec2::NEG_INFINITY, |a, &p| a.max(p));
-        if !(area > 1e-12 * (1.0 + (hi - lo).length_squared())) {
+        let flat = area.partial_cmp(&(1e-12 * (1.0 + (hi - lo).length_squared())));
+        if flat != Some(std::cmp::Ordering::Greater) {
             let p = poly.first().copied().unwrap_or_default().floor();
             let (x, y) = (p.x as i64, p.y as i64);
             return Integral {
@@ -356,8 +357,8 @@ impl Table {
         // Cells inside the polygon (most of a large one's) need no clipping.
         if poly.contains_rect(rect) {
             let s = self.rect_sum(x0, x1, y0, y1);
-            for k in 0..4 {
-                acc.sum[k] += s[k];
+            for (a, v) in acc.sum.iter_mut().zip(s) {
+                *a += v;
             }
             return;
         }
@@ -370,8 +371,8 @@ impl Table {
         if full || (w as f64) <= min_cell && (h as f64) <= min_cell {
             let s = self.rect_sum(x0, x1, y0, y1);
             let weight = if full { 1.0 } else { covered / cell_area };
-            for k in 0..4 {
-                acc.sum[k] += weight * s[k];
+            for (a, v) in acc.sum.iter_mut().zip(s) {
+                *a += weight * v;
             }
             if !full && cell_area > 1.0 {
                 acc.bound += cell_area;
