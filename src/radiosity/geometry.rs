@@ -214,6 +214,8 @@ pub fn cosine_direction(n: DVec3, u: f64, v: f64) -> DVec3 {
 pub struct AreaSampler {
     /// (a, b, c, normal) of each fan triangle.
     triangles: Vec<(DVec3, DVec3, DVec3, DVec3)>,
+    /// The polygon (its index in the order given) each fan triangle comes from.
+    sources: Vec<u32>,
     /// Cumulative areas, normalised so the last is 1.
     cumulative: Vec<f64>,
     /// Total area.
@@ -225,13 +227,14 @@ impl AreaSampler {
     pub fn new<'a>(polygons: impl IntoIterator<Item = (&'a [DVec3], DVec3)>) -> Self {
         let mut s = AreaSampler::default();
         let mut total = 0.0;
-        for (poly, n) in polygons {
+        for (source, (poly, n)) in polygons.into_iter().enumerate() {
             for i in 1..poly.len().saturating_sub(1) {
                 let (a, b, c) = (poly[0], poly[i], poly[i + 1]);
                 let area = 0.5 * (b - a).cross(c - a).length();
                 if area > 0.0 {
                     total += area;
                     s.triangles.push((a, b, c, n));
+                    s.sources.push(source as u32);
                     s.cumulative.push(total);
                 }
             }
@@ -259,6 +262,16 @@ impl AreaSampler {
     /// first coordinate inside it.
     pub fn sample_square(&self, u: f64, v: f64) -> (DVec3, DVec3) {
         self.sample_square_inset(u, v, 0.0)
+    }
+
+    /// The polygon (index in the order given to [`AreaSampler::new`]) that
+    /// [`AreaSampler::sample_square`] draws `u` from.
+    pub fn source(&self, u: f64) -> usize {
+        let k = self
+            .cumulative
+            .partition_point(|&c| c <= u)
+            .min(self.triangles.len() - 1);
+        self.sources[k] as usize
     }
 
     /// [`AreaSampler::sample_square`] in each fan triangle shrunk about its incentre so that its

@@ -110,3 +110,38 @@ fn a_material_cut_out_everywhere_blocks_nothing() {
     let from = DVec3::new(2.0, 2.0, 2.0);
     assert!(!vis.occluded(from, DVec3::new(2.1, 0.001, 2.2)));
 }
+
+/// Direct-light sample points of a partly cut-out patch lie on opaque texels (a point on a
+/// cut-out texel is drawn again), and its area counts only the opaque half.
+#[test]
+fn sample_points_of_masked_patches_lie_on_opaque_texels() {
+    use relume::radiosity::patches::voxelize::{voxelize, Resolution, VoxelizeParams};
+    // A checkerboard: every 1 × 1 voxel of the quad holds two opaque and two cut-out texels.
+    let bits = 0xaa55_aa55_aa55_aa55u64;
+    let scene = masked_scene(bits);
+    let params = VoxelizeParams {
+        resolution: Resolution::VoxelSize(1.0),
+        samples_per_patch: 16,
+    };
+    let set = voxelize(&scene, &params).unwrap();
+    let spp = set.samples_per_patch as usize;
+    let mut checked = 0;
+    for (i, p) in set.patches.iter().enumerate() {
+        if (p.centroid[1] - 1.0).abs() > 1e-6 {
+            continue; // the floor
+        }
+        assert!(
+            (p.area - 0.5).abs() < 1e-6,
+            "half of a 1 × 1 patch is opaque: {}",
+            p.area
+        );
+        for s in &set.samples[i * spp..(i + 1) * spp] {
+            let [x, _, z] = s.position.map(f64::from);
+            if let Some(opaque) = opaque_at(bits, x, z) {
+                assert!(opaque, "sample at ({x}, {z}) lies on a cut-out texel");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 150, "{checked} samples checked");
+}

@@ -29,6 +29,7 @@ use crate::radiosity::patches::clip::{clip_pieces, clusters, grid_dims, SNAP};
 use crate::radiosity::patches::overlap::{self, Face};
 use crate::radiosity::patches::voxel_size::SizeSearch;
 use crate::radiosity::{Patch, PatchLists, PatchSet, Piece, SurfacePoint, VoxelizeStats};
+use crate::raytrace::alpha::{AlphaMasks, Cutout, MaskedTriangle};
 use crate::raytrace::visibility::Visibility;
 use crate::scene::Scene;
 use glam::DVec3;
@@ -57,6 +58,23 @@ pub struct VoxelizeParams {
 
 /// Seed of the per-patch sample points.
 const SAMPLE_SEED: u64 = 0x5a3b_1e5e;
+
+/// Draws of a direct-light sample point before one on a cut-out texel is kept anyway.
+const MASK_TRIES: usize = 64;
+
+/// True when grid point `p` on scene triangle `t` is not cut away by its material's mask.
+fn opaque_at(scene: &Scene, frame: &Frame, masks: &AlphaMasks, t: usize, p: DVec3) -> bool {
+    match masks.cutout(scene, t) {
+        Cutout::Nowhere => true,
+        Cutout::Everywhere => false,
+        Cutout::Masked(image) => {
+            let v = scene.triangles[t]
+                .map(|i| frame.to_grid(scene.positions[i as usize]).as_vec3().into());
+            let uv = masks.corner_uvs(scene, t);
+            MaskedTriangle { image, uv }.opaque_at(masks, &v, p.as_vec3().into())
+        }
+    }
+}
 
 /// Simplify `scene` into patches. Preconditions: the scene passed [`Scene::validate`].
 pub fn voxelize(scene: &Scene, params: &VoxelizeParams) -> Result<PatchSet> {
@@ -178,12 +196,25 @@ pub fn voxelize_noting(
     drop(pieces);
 
     // Direct-light sample points and the triangle → patch map.
+    // On alpha-masked pieces a point on a cut-out texel is drawn again (up to MASK_TRIES times).
     set.samples_per_patch = params.samples_per_patch;
+    let masks = AlphaMasks::new(scene);
     for (i, patch) in set.patches.iter().enumerate() {
         let sampler = set.piece_sampler(patch);
+        let triangles: Vec<u32> = set.patch_pieces(patch).iter().map(|p| p.triangle).collect();
         let mut rng = geometry::item_rng(SAMPLE_SEED, i as u64, 0);
         let k = params.samples_per_patch as usize;
         for (u, v) in rng.jittered(k) {
+            let (mut u, mut v) = (u, v);
+            let mut tries = 0;
+            while tries < MASK_TRIES && !masks.is_empty() {
+                let t = triangles[sampler.source(u)] as usize;
+                let (p, _) = sampler.sample_square(u, v);
+                if opaque_at(scene, &frame, &masks, t, p) {
+                    break;
+                }
+                (u, v, tries) = (rng.f64(), rng.f64(), tries + 1);
+            }
             let (p, n) = sampler.sample_square(u, v);
             set.samples.push(SurfacePoint {
                 position: frame.to_world(p).as_vec3().to_array(),
