@@ -9,7 +9,7 @@ use std::io::Read;
 use std::path::Path;
 
 /// Version of the baked-directory format. Readers refuse other versions.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// The manifest's file name inside a baked directory.
 pub const MANIFEST: &str = "manifest.ron";
