@@ -2,13 +2,7 @@
 //! encoding. The WGSL twin is `tonemap` in `shaders/common.wgsl`; tests compare them.
 
 /// Linear → sRGB transfer (IEC 61966-2-1). Twin of `linear_to_srgb` in common.wgsl.
-pub fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.0031308 {
-        12.92 * c.max(0.0)
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
+pub use crate::scene::texture::linear_to_srgb;
 
 /// Map linear radiance to display sRGB in [0, 1]: `x·exposure / (1 + x·exposure)` per channel
 /// (Reinhard), then sRGB. Twin of `tonemap` in common.wgsl.

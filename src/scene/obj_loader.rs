@@ -166,8 +166,9 @@ fn material(
 /// The texture files the materials name: found once each, decoded together at the end.
 #[derive(Default)]
 struct TextureFiles {
-    /// Written name (relative to the MTL's folder) → path found on disk.
-    found: HashMap<String, PathBuf>,
+    /// Written name (relative to the MTL's folder) → path found on disk (None: missing, warned
+    /// once).
+    found: HashMap<String, Option<PathBuf>>,
     /// Distinct paths in first-use order; a texture's index is its position here.
     paths: Vec<PathBuf>,
 }
@@ -180,29 +181,23 @@ impl TextureFiles {
         st: &TextureStatement,
         warnings: &mut LoadWarnings,
     ) -> Option<u32> {
-        let path = match self.found.get(&st.file) {
-            Some(p) => p.clone(),
-            None => match mtl::resolve(dir, &st.file) {
-                Some((found, other_case)) => {
-                    if other_case {
-                        warnings.push(format!(
-                            "texture `{}` does not exist; using `{}` (the names differ in case)",
-                            dir.join(&st.file).display(),
-                            found.display()
-                        ));
-                    }
-                    self.found.insert(st.file.clone(), found.clone());
-                    found
-                }
-                None => {
-                    warnings.push(format!(
-                        "texture `{}` does not exist; using the material's colour factor alone",
-                        dir.join(&st.file).display()
-                    ));
-                    return None;
-                }
-            },
-        };
+        if !self.found.contains_key(&st.file) {
+            let found = mtl::resolve(dir, &st.file);
+            match &found {
+                Some((path, true)) => warnings.push(format!(
+                    "texture `{}` does not exist; using `{}` (the names differ in case)",
+                    dir.join(&st.file).display(),
+                    path.display()
+                )),
+                Some(_) => {}
+                None => warnings.push(format!(
+                    "texture `{}` does not exist; using the material's colour factor alone",
+                    dir.join(&st.file).display()
+                )),
+            }
+            self.found.insert(st.file.clone(), found.map(|(p, _)| p));
+        }
+        let path = self.found[&st.file].clone()?;
         Some(match self.paths.iter().position(|p| *p == path) {
             Some(i) => i as u32,
             None => {

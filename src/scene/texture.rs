@@ -116,10 +116,12 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
-/// The sRGB transfer function (IEC 61966-2-1).
+/// The sRGB transfer function (IEC 61966-2-1), negative values encoded as 0: the one encoder
+/// of the library (`render::tonemap` re-exports it), twin of `linear_to_srgb` in
+/// `shaders/common.wgsl`.
 pub fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.003_130_8 {
-        c * 12.92
+    if c <= 0.0031308 {
+        12.92 * c.max(0.0)
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     }
@@ -210,19 +212,6 @@ impl Texture {
             self.texels[i + 2],
             self.texels[i + 3],
         ]
-    }
-
-    /// Linear RGB of the texel under image coordinates `uv` (nearest texel).
-    pub fn linear_rgb(&self, uv: [f32; 2], wrap: [Wrap; 2]) -> [f32; 3] {
-        let t = self.texel_at(uv, wrap);
-        [0, 1, 2].map(|c| srgb_to_linear(t[c] as f32 / 255.0))
-    }
-
-    /// The stored RGBA8 texel under image coordinates `uv` (nearest texel).
-    pub fn texel_at(&self, uv: [f32; 2], wrap: [Wrap; 2]) -> [u8; 4] {
-        let x = (uv[0] as f64 * self.width as f64).floor() as i64;
-        let y = (uv[1] as f64 * self.height as f64).floor() as i64;
-        self.texel(x, y, wrap)
     }
 
     /// True when every texel has R = G = B.
