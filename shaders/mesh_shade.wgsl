@@ -2,13 +2,14 @@
 // indirect light transferred from the patches (per corner, interpolated), emission, tone map.
 // Rust twin: relume::render::mesh_reference (CPU ray caster with BVH visibility).
 //! include lighting.wgsl
+//! include material.wgsl
 
 struct Frame {
     view_proj: mat4x4<f32>,
     eye: vec4<f32>,
     exposure: f32,
     emission_scale: f32,
-    flags: u32,        // bit 0 direct, bit 1 indirect, bit 2 shadows, bit 3 emission
+    flags: u32,        // bit 0 direct, bit 1 indirect, bit 2 shadows, bit 3 emission, bit 4 textures
     _pad: u32,
 }
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -19,6 +20,7 @@ struct VertexIn {
     @location(2) albedo: vec3<f32>,
     @location(3) emission: vec3<f32>,
     @location(4) indirect: vec3<f32>,
+    @location(5) uv: vec2<f32>,
 }
 
 struct VertexOut {
@@ -28,6 +30,7 @@ struct VertexOut {
     @location(2) albedo: vec3<f32>,
     @location(3) emission: vec3<f32>,
     @location(4) indirect: vec3<f32>,
+    @location(5) uv: vec2<f32>,
 }
 
 @vertex
@@ -39,6 +42,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     o.albedo = v.albedo;
     o.emission = v.emission;
     o.indirect = v.indirect;
+    o.uv = v.uv;
     return o;
 }
 
@@ -70,11 +74,20 @@ fn shade_point(p: vec3<f32>, n_in: vec3<f32>, albedo: vec3<f32>, emission: vec3<
 
 @fragment
 fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    // Both lookups before any branch: their mip level comes from the uv derivatives.
+    let texel = textureSample(albedo_map, albedo_sampler, albedo_coords(v.uv)).rgb;
+    if (masked_out(v.uv)) {
+        discard;
+    }
+    var albedo = v.albedo;
+    if ((frame.flags & 16u) != 0u && (material.flags.x & 1u) != 0u) {
+        albedo = material.factor.rgb * texel;
+    }
     // Two-sided: light the side facing the viewer (open scenes show back faces).
     var n = normalize(v.normal);
     if (!front) {
         n = -n;
     }
-    let radiance = shade_point(v.world, n, v.albedo, v.emission, v.indirect);
+    let radiance = shade_point(v.world, n, albedo, v.emission, v.indirect);
     return vec4<f32>(tonemap(radiance, frame.exposure), 1.0);
 }

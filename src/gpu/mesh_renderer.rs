@@ -1,14 +1,18 @@
 //! Rasterising a mesh scene: one shadow-map layer per directional/spot light (six per point
-//! light), then `mesh_shade.wgsl` (direct per pixel + indirect per corner + emission, tone map)
-//! into an RGBA8 target. The CPU twin is `relume::render::mesh_reference`.
+//! light; alpha-masked materials through `shadow_masked.wgsl`), then `mesh_shade.wgsl` (direct
+//! per pixel + indirect per corner + emission, albedo textures, alpha test, tone map) into an
+//! RGBA8 target, one indexed draw per material ([`super::mesh_materials`]). The CPU twins are
+//! `relume::render::mesh_reference` and `relume::render::material_maps`.
 
+use super::mesh_materials::GpuMaterials;
 use super::render_target::{RenderTarget, DEPTH_FORMAT, TARGET_FORMAT};
 use super::timing::PassTimer;
 use super::Gpu;
 use crate::error::{Error, Result};
 use crate::render::camera::Camera;
 use crate::render::lights::{shadow_projections, GpuLight, MAX_LIGHTS, MAX_SHADOW_LAYERS};
-use crate::render::mesh_reference::{corner_vertices, FrameSettings};
+use crate::render::material_maps::SceneMaps;
+use crate::render::mesh_reference::{corner_uvs, corner_vertices, FrameSettings};
 use crate::scene::Scene;
 use wgpu::util::DeviceExt;
 
@@ -39,8 +43,12 @@ pub struct FrameUniform {
 pub struct MeshRenderer {
     shade: wgpu::RenderPipeline,
     shadow: wgpu::RenderPipeline,
+    shadow_masked: wgpu::RenderPipeline,
     vertices: wgpu::Buffer,
     positions: wgpu::Buffer,
+    uvs: wgpu::Buffer,
+    /// Textures, per-material bind groups and the corners in material order.
+    pub materials: GpuMaterials,
     /// Per-corner indirect exitance (3 × f32 per corner), written by the gather or by `set_indirect`.
     pub indirect: wgpu::Buffer,
     corners: u32,
@@ -90,6 +98,12 @@ impl MeshRenderer {
             contents: bytemuck::cast_slice(&positions),
             usage: wgpu::BufferUsages::VERTEX,
         });
+        let uvs = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("mesh texture coordinates"),
+            contents: bytemuck::cast_slice(&corner_uvs(scene)),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let materials = GpuMaterials::new(gpu, scene, &SceneMaps::new(scene, max));
         let indirect = dev.create_buffer(&wgpu::BufferDescriptor {
             label: Some("indirect per corner"),
             size: (corners as u64 * 12).max(16),
@@ -213,13 +227,22 @@ impl MeshRenderer {
                 resource: lights.as_entire_binding(),
             }],
         });
-        let (shade, shadow) = pipelines(gpu, &group0_layout, &group1_layout, &lights_only_layout)?;
+        let layouts = [
+            &group0_layout,
+            &group1_layout,
+            &lights_only_layout,
+            &materials.layout,
+        ];
+        let (shade, shadow, shadow_masked) = pipelines(gpu, layouts)?;
         let (lo, hi) = scene.bounds();
         Ok(MeshRenderer {
             shade,
             shadow,
+            shadow_masked,
             vertices,
             positions,
+            uvs,
+            materials,
             indirect,
             corners,
             lights,
@@ -306,10 +329,18 @@ impl MeshRenderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
+            let m = &self.materials;
+            pass.set_index_buffer(m.index.slice(..), wgpu::IndexFormat::Uint32);
             pass.set_pipeline(&self.shadow);
             pass.set_bind_group(1, &self.shadow_group1, &[]);
             pass.set_vertex_buffer(0, self.positions.slice(..));
-            pass.draw(0..self.corners, layer..layer + 1);
+            pass.draw_indexed(0..m.opaque_corners, 0, layer..layer + 1);
+            pass.set_pipeline(&self.shadow_masked);
+            pass.set_vertex_buffer(1, self.uvs.slice(..));
+            for d in m.draws.iter().filter(|d| d.masked) {
+                pass.set_bind_group(2, &m.groups[d.material], &[]);
+                pass.draw_indexed(d.first..d.first + d.count, 0, layer..layer + 1);
+            }
         }
     }
 
@@ -340,7 +371,13 @@ impl MeshRenderer {
         pass.set_bind_group(1, &self.group1, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_vertex_buffer(1, self.indirect.slice(..));
-        pass.draw(0..self.corners, 0..1);
+        pass.set_vertex_buffer(2, self.uvs.slice(..));
+        let m = &self.materials;
+        pass.set_index_buffer(m.index.slice(..), wgpu::IndexFormat::Uint32);
+        for d in &m.draws {
+            pass.set_bind_group(2, &m.groups[d.material], &[]);
+            pass.draw_indexed(d.first..d.first + d.count, 0, 0..1);
+        }
     }
 
     /// Resize the render target.
@@ -386,18 +423,29 @@ pub fn lighting_layout(gpu: &Gpu) -> wgpu::BindGroupLayout {
         })
 }
 
+/// The shading, shadow and masked-shadow pipelines; `layouts`: frame, lighting, lights only,
+/// material.
 fn pipelines(
     gpu: &Gpu,
-    g0: &wgpu::BindGroupLayout,
-    g1: &wgpu::BindGroupLayout,
-    lights_only: &wgpu::BindGroupLayout,
-) -> Result<(wgpu::RenderPipeline, wgpu::RenderPipeline)> {
+    layouts: [&wgpu::BindGroupLayout; 4],
+) -> Result<(
+    wgpu::RenderPipeline,
+    wgpu::RenderPipeline,
+    wgpu::RenderPipeline,
+)> {
+    let [g0, g1, lights_only, material] = layouts;
     let dev = &gpu.device;
     let shade_mod = gpu.shader("mesh_shade.wgsl")?;
     let shadow_mod = gpu.shader("shadow_depth.wgsl")?;
+    let masked_mod = gpu.shader("shadow_masked.wgsl")?;
     let shade_layout = dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: None,
-        bind_group_layouts: &[Some(g0), Some(g1)],
+        bind_group_layouts: &[Some(g0), Some(g1), Some(material)],
+        immediate_size: 0,
+    });
+    let masked_layout = dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &[None, Some(lights_only), Some(material)],
         immediate_size: 0,
     });
     let shadow_layout = dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -410,8 +458,14 @@ fn pipelines(
         offset,
         shader_location: loc,
     };
+    let f2 = |loc: u32| wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x2,
+        offset: 0,
+        shader_location: loc,
+    };
     let mesh_attrs = [f3(0, 0), f3(1, 12), f3(2, 24), f3(3, 36)];
     let indirect_attrs = [f3(4, 0)];
+    let uv_attrs = [f2(5)];
     let depth = |bias: wgpu::DepthBiasState| wgpu::DepthStencilState {
         format: DEPTH_FORMAT,
         depth_write_enabled: Some(true),
@@ -437,6 +491,11 @@ fn pipelines(
                     step_mode: wgpu::VertexStepMode::Vertex,
                     attributes: &indirect_attrs,
                 }),
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: 8,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &uv_attrs,
+                }),
             ],
         },
         primitive: wgpu::PrimitiveState {
@@ -455,32 +514,64 @@ fn pipelines(
         cache: None,
     });
     let pos_attrs = [f3(0, 0)];
-    let shadow = dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("shadow depth"),
-        layout: Some(&shadow_layout),
-        vertex: wgpu::VertexState {
-            module: &shadow_mod,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: 12,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &pos_attrs,
-            })],
-        },
-        primitive: wgpu::PrimitiveState {
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(depth(wgpu::DepthBiasState {
-            constant: 2,
-            slope_scale: 2.0,
-            clamp: 0.0,
-        })),
-        multisample: Default::default(),
-        fragment: None,
-        multiview_mask: None,
-        cache: None,
-    });
-    Ok((shade, shadow))
+    let shadow_uv_attrs = [f2(1)];
+    let position_buffer = wgpu::VertexBufferLayout {
+        array_stride: 12,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &pos_attrs,
+    };
+    let uv_buffer = wgpu::VertexBufferLayout {
+        array_stride: 8,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &shadow_uv_attrs,
+    };
+    let shadow_pipeline = |label: &str,
+                           layout: &wgpu::PipelineLayout,
+                           module: &wgpu::ShaderModule,
+                           buffers: &[Option<wgpu::VertexBufferLayout>],
+                           fragment: bool| {
+        dev.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers,
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(depth(wgpu::DepthBiasState {
+                constant: 2,
+                slope_scale: 2.0,
+                clamp: 0.0,
+            })),
+            multisample: Default::default(),
+            fragment: fragment.then(|| wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let shadow = shadow_pipeline(
+        "shadow depth",
+        &shadow_layout,
+        &shadow_mod,
+        &[Some(position_buffer.clone())],
+        false,
+    );
+    let shadow_masked = shadow_pipeline(
+        "shadow depth, alpha-masked",
+        &masked_layout,
+        &masked_mod,
+        &[Some(position_buffer), Some(uv_buffer)],
+        true,
+    );
+    Ok((shade, shadow, shadow_masked))
 }

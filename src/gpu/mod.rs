@@ -11,6 +11,7 @@ pub mod compressed_gather;
 pub mod compute;
 pub mod freeform_caster;
 pub mod freeform_shader;
+pub mod mesh_materials;
 pub mod mesh_renderer;
 pub mod radiosity_runtime;
 pub mod readback;
@@ -196,8 +197,10 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "gather_compressed.wgsl",
     "gather_dense.wgsl",
     "lighting.wgsl",
+    "material.wgsl",
     "mesh_shade.wgsl",
     "shadow_depth.wgsl",
+    "shadow_masked.wgsl",
     "terrain_mask.wgsl",
     "terrain_render.wgsl",
     "terrain_shadow.wgsl",

@@ -1,6 +1,7 @@
 //! The runtime: load a baked directory and render frames with wgpu. The binary
 //! (`relume-player`) only parses arguments and runs the window or headless loop around this.
 
+pub mod camera_rig;
 mod freeform;
 pub mod headless;
 mod mesh;
@@ -95,6 +96,21 @@ impl Player {
             Player::Mesh(m) => m.default_camera(),
             Player::Terrain(t) => t.default_camera(),
             Player::Freeform(f) => f.default_camera(),
+        }
+    }
+
+    /// The size the fly camera's speed scales with: a mesh scene's bounding-box diagonal, else
+    /// twice the default camera's distance to its target.
+    pub fn diagonal(&self) -> f32 {
+        match self {
+            Player::Mesh(m) => {
+                let (lo, hi) = m.scene.bounds();
+                (hi - lo).length()
+            }
+            _ => {
+                let c = self.default_camera();
+                2.0 * (c.eye - c.target).length()
+            }
         }
     }
 

@@ -1,9 +1,11 @@
-//! The interactive window (winit): orbit camera, sun keys, toggles, frame time in the title.
+//! The interactive window (winit): orbit and fly cameras ([`super::camera_rig`]), sun keys,
+//! toggles, frame time in the title.
 
 use crate::error::{Error, Result};
 use crate::gpu::blit::Blit;
 use crate::gpu::timing::PassTimer;
 use crate::gpu::{BackendChoice, Gpu};
+use crate::player::camera_rig::{Fly, Held, Orbit};
 use crate::player::{Player, PlayerOptions, Sun};
 use crate::render::camera::Camera;
 use crate::render::mesh_reference::FrameSettings;
@@ -17,38 +19,6 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
-struct Orbit {
-    target: glam::Vec3,
-    distance: f32,
-    azimuth: f32,
-    elevation: f32,
-    fov: f32,
-}
-
-impl Orbit {
-    fn from_camera(c: &Camera) -> Orbit {
-        let v = c.eye - c.target;
-        let distance = v.length().max(1e-6);
-        Orbit {
-            target: c.target,
-            distance,
-            azimuth: v.x.atan2(v.z).to_degrees(),
-            elevation: (v.y / distance).clamp(-1.0, 1.0).asin().to_degrees(),
-            fov: c.fov_y_deg,
-        }
-    }
-
-    fn camera(&self) -> Camera {
-        Camera::orbit(
-            self.target,
-            self.distance,
-            self.azimuth,
-            self.elevation,
-            self.fov,
-        )
-    }
-}
-
 struct Running {
     window: Arc<Window>,
     surface: wgpu::Surface<'static>,
@@ -58,8 +28,23 @@ struct Running {
     blit: Blit,
     timer: PassTimer,
     orbit: Orbit,
+    /// The fly camera, while it is the one in use (`F` switches).
+    fly: Option<Fly>,
+    held: Held,
     last: Instant,
+    last_frame: Instant,
     frame_ms: f64,
+    /// The scene's bounding-box diagonal (the fly camera's speed scale).
+    diagonal: f32,
+}
+
+impl Running {
+    fn camera(&self) -> Camera {
+        match &self.fly {
+            Some(f) => f.camera(),
+            None => self.orbit.camera(),
+        }
+    }
 }
 
 /// What the window shows, from the command line.
@@ -174,6 +159,7 @@ impl App {
             Orbit::from_camera(&self.plan.camera.unwrap_or_else(|| player.default_camera()));
         let blit = Blit::new(&gpu, format)?;
         let timer = PassTimer::new(&gpu, 48);
+        let diagonal = player.diagonal();
         Ok(Running {
             window,
             surface,
@@ -183,8 +169,12 @@ impl App {
             blit,
             timer,
             orbit,
+            fly: None,
+            held: Held::default(),
             last: Instant::now(),
+            last_frame: Instant::now(),
             frame_ms: 0.0,
+            diagonal,
         })
     }
 
@@ -194,9 +184,16 @@ impl App {
             return Ok(false);
         };
         let t0 = Instant::now();
+        // Seconds since the last frame, capped so that a stall does not fling the camera.
+        let dt = t0.duration_since(r.last_frame).as_secs_f32().min(0.1);
+        r.last_frame = t0;
+        if let Some(f) = r.fly.as_mut() {
+            f.step(r.held, dt);
+        }
         r.player.set_frame(&r.gpu, self.frames, &self.plan.settings);
+        let camera = r.camera();
         r.player
-            .render(&r.gpu, &r.orbit.camera(), &self.plan.settings, &mut r.timer)?;
+            .render(&r.gpu, &camera, &self.plan.settings, &mut r.timer)?;
         let frame = match r.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f)
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -213,8 +210,12 @@ impl App {
         if r.last.elapsed().as_millis() > 250 {
             r.last = Instant::now();
             let s = &self.plan.settings;
+            let mode = match &r.fly {
+                Some(f) => format!("fly {:.2} m/s", f.speed),
+                None => "orbit".into(),
+            };
             r.window.set_title(&format!(
-                "relume-player — {:.1} ms/frame — sun {:.0}°/{:.0}°{} — direct {} indirect {} shadows {} emission {}",
+                "relume-player — {:.1} ms/frame — {mode} — sun {:.0}°/{:.0}°{} — direct {} indirect {} shadows {} emission {} textures {}",
                 r.frame_ms,
                 self.sun.azimuth_deg,
                 self.sun.elevation_deg,
@@ -222,7 +223,8 @@ impl App {
                 on(s.direct),
                 on(s.indirect),
                 on(s.shadows),
-                on(s.emission)
+                on(s.emission),
+                on(s.textures)
             ));
         }
         r.window.request_redraw();
@@ -235,6 +237,24 @@ impl App {
             return Ok(false);
         };
         let mut sun_changed = false;
+        if let Key::Character(c) = key {
+            match c.to_ascii_lowercase().as_str() {
+                "f" => {
+                    r.fly = match r.fly {
+                        Some(_) => None,
+                        None => Some(Fly::from_camera(&r.orbit.camera(), r.diagonal)),
+                    };
+                    r.held = Held::default();
+                    return Ok(false);
+                }
+                "t" => {
+                    self.plan.settings.textures = !self.plan.settings.textures;
+                    return Ok(false);
+                }
+                "w" | "a" | "s" | "d" | "q" | "e" if r.fly.is_some() => return Ok(false),
+                _ => {}
+            }
+        }
         match key {
             Key::Named(NamedKey::Escape) => return Ok(true),
             Key::Named(NamedKey::ArrowLeft) => r.orbit.azimuth -= 5.0,
@@ -295,6 +315,23 @@ impl App {
     }
 }
 
+/// Record a movement key going down or up (W A S D, Q E, Shift); other keys change nothing.
+fn hold(held: &mut Held, key: &Key, down: bool) {
+    match key {
+        Key::Named(NamedKey::Shift) => held.fast = down,
+        Key::Character(c) => match c.to_ascii_lowercase().as_str() {
+            "w" => held.forward = down,
+            "s" => held.back = down,
+            "a" => held.left = down,
+            "d" => held.right = down,
+            "q" => held.down = down,
+            "e" => held.up = down,
+            _ => {}
+        },
+        _ => {}
+    }
+}
+
 fn on(b: bool) -> &'static str {
     if b {
         "on"
@@ -344,7 +381,13 @@ impl ApplicationHandler for App {
                 Ok(false) => Ok(()),
                 Err(e) => Err(e),
             },
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let Some(r) = self.running.as_mut() {
+                    hold(&mut r.held, &event.logical_key, event.state.is_pressed());
+                }
+                if !event.state.is_pressed() {
+                    return;
+                }
                 match self.key(&event.logical_key) {
                     Ok(true) => {
                         el.exit();
@@ -365,9 +408,14 @@ impl ApplicationHandler for App {
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor = (position.x, position.y);
                 if let (Some((x0, y0)), Some(r)) = (self.dragging, self.running.as_mut()) {
-                    r.orbit.azimuth -= (position.x - x0) as f32 * 0.3;
-                    r.orbit.elevation =
-                        (r.orbit.elevation + (position.y - y0) as f32 * 0.3).clamp(-89.0, 89.0);
+                    let (dx, dy) = ((position.x - x0) as f32, (position.y - y0) as f32);
+                    match r.fly.as_mut() {
+                        Some(f) => f.look(dx, dy),
+                        None => {
+                            r.orbit.azimuth -= dx * 0.3;
+                            r.orbit.elevation = (r.orbit.elevation + dy * 0.3).clamp(-89.0, 89.0);
+                        }
+                    }
                     self.dragging = Some((position.x, position.y));
                 }
                 Ok(())
@@ -378,7 +426,10 @@ impl ApplicationHandler for App {
                         MouseScrollDelta::LineDelta(_, y) => y,
                         MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                     };
-                    r.orbit.distance *= 0.9f32.powf(d);
+                    match r.fly.as_mut() {
+                        Some(f) => f.speed *= 1.25f32.powf(d),
+                        None => r.orbit.distance *= 0.9f32.powf(d),
+                    }
                 }
                 Ok(())
             }

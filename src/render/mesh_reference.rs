@@ -33,6 +33,13 @@ pub struct FrameSettings {
     pub theme_animation: bool,
     /// Display colour behind the scene (sRGB, 0..1).
     pub background: [f32; 3],
+    /// Mesh scenes: albedo textures (off: each material's mean albedo, the patches' clay view).
+    #[serde(default = "yes")]
+    pub textures: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for FrameSettings {
@@ -51,6 +58,7 @@ impl Default for FrameSettings {
             themes: true,
             theme_animation: true,
             background: [0.0; 3],
+            textures: true,
         }
     }
 }
@@ -62,6 +70,7 @@ impl FrameSettings {
             | (self.indirect as u32) << 1
             | (self.shadows as u32) << 2
             | (self.emission as u32) << 3
+            | (self.textures as u32) << 4
     }
 }
 
@@ -95,6 +104,20 @@ pub fn corner_vertices(scene: &Scene) -> Vec<f32> {
         }
     }
     out
+}
+
+/// Per-corner texture coordinates (2 floats per corner, in the order of [`corner_vertices`]);
+/// zeros for a scene without them.
+pub fn corner_uvs(scene: &Scene) -> Vec<f32> {
+    if scene.uvs.is_empty() {
+        return vec![0.0; 6 * scene.triangles.len()];
+    }
+    scene
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(|v| scene.uvs[v as usize]))
+        .flatten()
+        .collect()
 }
 
 /// Outgoing radiance at a surface point: twin of `shade_point` in mesh_shade.wgsl.

@@ -5,6 +5,7 @@ pub mod direct;
 pub mod freeform_image;
 pub mod freeform_shade;
 pub mod lights;
+pub mod material_maps;
 pub mod mesh_reference;
 pub mod raycast;
 pub mod terrain_shading;

@@ -1,16 +1,20 @@
 //! The CPU reference image of a mesh frame: one primary ray per pixel centre through the same
 //! camera, the same per-corner vertex data and indirect light as the GPU, `shade_point` and the
 //! tone map; punctual-light visibility by shadow rays through the BVH (the GPU uses shadow maps,
-//! so the two images differ only near shadow edges).
+//! so the two images differ only near shadow edges). Albedo textures are read through
+//! [`SceneMaps`] at the level of detail of the pixel's footprint (ray differentials to the
+//! neighbouring pixels' rays); alpha masks by the tracer's nearest-texel rule (the GPU filters
+//! them, so mask edges may differ by a pixel).
 
 use super::camera::Camera;
 use super::lights::{GpuLight, KIND_DIRECTIONAL};
-use super::mesh_reference::{corner_vertices, display, shade_point, FrameSettings};
+use super::material_maps::{level_of_detail, SceneMaps};
+use super::mesh_reference::{corner_uvs, corner_vertices, display, shade_point, FrameSettings};
 use super::tonemap::to_u8;
 use crate::radiosity::geometry::Frame;
 use crate::raytrace::visibility::Visibility;
 use crate::scene::{Material, Scene};
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
 /// A scene prepared for reference ray casting.
@@ -18,6 +22,10 @@ pub struct RaycastScene {
     verts: Vec<f32>,
     vis: Visibility,
     extent: f32,
+    /// Per-corner texture coordinates, the material of each triangle, and the maps.
+    uvs: Vec<f32>,
+    triangle_material: Vec<u32>,
+    maps: SceneMaps,
 }
 
 impl RaycastScene {
@@ -74,7 +82,55 @@ impl RaycastScene {
             },
             extent as f64,
         );
-        RaycastScene { verts, vis, extent }
+        RaycastScene {
+            verts,
+            vis,
+            extent,
+            uvs: corner_uvs(scene),
+            triangle_material: scene.triangle_material.clone(),
+            maps: SceneMaps::new(scene, u32::MAX),
+        }
+    }
+
+    /// The textured albedo seen through pixel (`x`, `y`) where its ray hits triangle `t` at `p`
+    /// (`None` for an untextured material): the map read at the level of detail of the pixel's
+    /// footprint, from where the neighbouring pixels' rays meet the triangle's plane.
+    #[allow(clippy::too_many_arguments)]
+    fn textured_albedo(
+        &self,
+        camera: &Camera,
+        (x, y, width, height): (u32, u32, u32, u32),
+        t: usize,
+        p: Vec3,
+        corners: [Vec3; 3],
+    ) -> Option<Vec3> {
+        let m = self.triangle_material[t] as usize;
+        let (tw, th) = self.maps.base_size(m)?;
+        let [a, b, c] = corners;
+        let uv_at = |q: Vec3| {
+            let w = barycentric(q, a, b, c);
+            (0..3)
+                .map(|k| w[k] * Vec2::from_slice(&self.uvs[2 * (3 * t + k)..][..2]))
+                .sum::<Vec2>()
+        };
+        let n = (b - a).cross(c - a);
+        let on_plane = |px: u32, py: u32| {
+            let (o, d) = camera.ray(px, py, width, height);
+            let den = n.dot(d);
+            (den.abs() > 0.0).then(|| o + d * (n.dot(a - o) / den))
+        };
+        let uv = uv_at(p);
+        let look = self.maps.materials[m]
+            .albedo
+            .as_ref()
+            .map(|(_, l)| l)
+            .or(self.maps.materials[m].mask.as_ref().map(|(_, l, _)| l))?;
+        let image = |q: Vec3| look.apply(uv_at(q)) - look.apply(uv);
+        let lod = match (on_plane(x + 1, y), on_plane(x, y + 1)) {
+            (Some(qx), Some(qy)) => level_of_detail(image(qx), image(qy), tw, th),
+            _ => 0.0,
+        };
+        self.maps.albedo_at(m, uv, lod)
     }
 
     /// Per-corner vertex data the scene was built from ([`corner_vertices`]: 12 floats per
@@ -144,7 +200,13 @@ impl RaycastScene {
                                     })
                                     .sum()
                             };
-                            let rad = shade_point(s, lights, p, n, v(0, 6), v(0, 9), ind, &visible);
+                            let albedo = if s.textures {
+                                self.textured_albedo(camera, (x, y, width, height), t, p, [a, b, c])
+                            } else {
+                                None
+                            };
+                            let albedo = albedo.unwrap_or(v(0, 6));
+                            let rad = shade_point(s, lights, p, n, albedo, v(0, 9), ind, &visible);
                             let c = display(s, rad);
                             [to_u8(c[0]), to_u8(c[1]), to_u8(c[2]), 255]
                         }

@@ -66,6 +66,7 @@ fn shared_structs() -> Vec<Shared> {
     use relume::gpu::compressed_gather::Params as GatherParams;
     use relume::gpu::freeform_caster::FrameU as FreeformFrame;
     use relume::gpu::freeform_shader::ShadeFrameU;
+    use relume::gpu::mesh_materials::MaterialUniform;
     use relume::gpu::mesh_renderer::FrameUniform;
     use relume::gpu::terrain_renderer::{TerrainFrame, TerrainParams};
     use relume::gpu::themes::ThemeParams;
@@ -101,6 +102,14 @@ fn shared_structs() -> Vec<Shared> {
             "emission_scale": field!(FrameUniform, emission_scale),
             "flags": field!(FrameUniform, flags),
             "_pad": field!(FrameUniform, pad),
+        }),
+        shared!("material.wgsl", "Material", MaterialUniform {
+            "albedo_u": field!(MaterialUniform, albedo_u),
+            "albedo_v": field!(MaterialUniform, albedo_v),
+            "mask_u": field!(MaterialUniform, mask_u),
+            "mask_v": field!(MaterialUniform, mask_v),
+            "factor": field!(MaterialUniform, factor),
+            "flags": field!(MaterialUniform, flags),
         }),
         shared!("gather_compressed.wgsl", "GatherParams", GatherParams {
             "n": field!(GatherParams, n),

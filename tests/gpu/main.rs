@@ -18,6 +18,7 @@ mod layout;
 mod player;
 mod terrain;
 mod terrain_air;
+mod textures;
 mod themes;
 mod twins_direct;
 mod twins_lighting;

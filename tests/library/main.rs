@@ -20,6 +20,7 @@ mod freeform_texture;
 mod history;
 mod independent_decoders;
 mod loaders;
+mod material_maps;
 mod reorder_bounded;
 mod textures;
 mod themes;
