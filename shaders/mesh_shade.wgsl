@@ -80,14 +80,18 @@ fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec
         discard;
     }
     var albedo = v.albedo;
+    var indirect = v.indirect;
     if ((frame.flags & 16u) != 0u && (material.flags.x & 1u) != 0u) {
         albedo = material.factor.rgb * texel;
+        // The patches reflect the material's mean albedo (the vertex albedo); the texel's
+        // departure from it modulates the indirect light too.
+        indirect = indirect * albedo / max(v.albedo, vec3<f32>(1e-6));
     }
     // Two-sided: light the side facing the viewer (open scenes show back faces).
     var n = normalize(v.normal);
     if (!front) {
         n = -n;
     }
-    let radiance = shade_point(v.world, n, albedo, v.emission, v.indirect);
+    let radiance = shade_point(v.world, n, albedo, v.emission, indirect);
     return vec4<f32>(tonemap(radiance, frame.exposure), 1.0);
 }

@@ -205,7 +205,12 @@ impl RaycastScene {
                             } else {
                                 None
                             };
-                            let albedo = albedo.unwrap_or(v(0, 6));
+                            // The patches reflect the material's mean albedo (the vertex
+                            // albedo); a texel's departure from it modulates indirect light.
+                            let (albedo, ind) = match albedo {
+                                Some(a) => (a, ind * a / v(0, 6).max(Vec3::splat(1e-6))),
+                                None => (v(0, 6), ind),
+                            };
                             let rad = shade_point(s, lights, p, n, albedo, v(0, 9), ind, &visible);
                             let c = display(s, rad);
                             [to_u8(c[0]), to_u8(c[1]), to_u8(c[2]), 255]

@@ -35,10 +35,26 @@ fn frames(
     camera: &Camera,
     lights: &[GpuLight],
     s: &FrameSettings,
+    size: (u32, u32),
+) -> (image::RgbaImage, image::RgbaImage) {
+    frames_with_indirect(gpu, scene, camera, lights, s, size, &[])
+}
+
+/// [`frames`] with per-corner indirect exitance (3 floats per corner; empty for none).
+fn frames_with_indirect(
+    gpu: &Gpu,
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[GpuLight],
+    s: &FrameSettings,
     (w, h): (u32, u32),
+    indirect: &[f32],
 ) -> (image::RgbaImage, image::RgbaImage) {
     let mut r = MeshRenderer::new(gpu, scene, w, h, 2048).unwrap();
     r.set_lights(gpu, lights).unwrap();
+    if !indirect.is_empty() {
+        r.set_indirect(gpu, indirect);
+    }
     let mut timer = PassTimer::new(gpu, 48);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     r.record_shadows(&mut enc, &mut timer);
@@ -47,7 +63,7 @@ fn frames(
     let got = r.target.read_image(gpu).unwrap();
     let u = r.lights_uniform();
     let lights = &u.lights[..u.count as usize];
-    let want = RaycastScene::new(scene).render(camera, lights, s, &[], w, h);
+    let want = RaycastScene::new(scene).render(camera, lights, s, indirect, w, h);
     (got, want)
 }
 
@@ -104,8 +120,10 @@ fn textured_quad(n: u32) -> Scene {
 #[test]
 fn albedo_textures_match_the_cpu_twin_magnified_and_minified() {
     let Some(gpu) = gpu() else { return };
-    // Light straight on at π lux: the quad's radiance is its albedo; no shadows to compare.
-    let lights = [sun(Vec3::NEG_Z, std::f32::consts::PI)];
+    // Light straight on at π/2 lux and indirect exitance 0.4 at every corner, which the texel's
+    // ratio to the material's mean albedo modulates; no shadows to compare.
+    let lights = [sun(Vec3::NEG_Z, std::f32::consts::FRAC_PI_2)];
+    let indirect = vec![0.4f32; 3 * 6];
     let s = FrameSettings {
         shadows: false,
         ..Default::default()
@@ -126,7 +144,15 @@ fn albedo_textures_match_the_cpu_twin_magnified_and_minified() {
         [(16, 2.0, "magnified", 10.0), (64, 3.46, "minified", 2.0)]
     {
         let scene = textured_quad(n);
-        let (got, want) = frames(&gpu, &scene, &look(distance), &lights, &s, (128, 128));
+        let (got, want) = frames_with_indirect(
+            &gpu,
+            &scene,
+            &look(distance),
+            &lights,
+            &s,
+            (128, 128),
+            &indirect,
+        );
         let (mean, outliers, worst) = compare(&got, &want, 6);
         eprintln!(
             "{what}: mean abs error {mean:.3}/255, {:.2} % pixels off by > 6, worst {worst}",
@@ -138,7 +164,7 @@ fn albedo_textures_match_the_cpu_twin_magnified_and_minified() {
         assert!(mean < 0.2, "{what}: mean error {mean}");
         assert!(worst <= 2, "{what}: worst {worst}");
         // The texture is really there: the clay view (the material's mean) differs.
-        let (clay, _) = frames(
+        let (clay, _) = frames_with_indirect(
             &gpu,
             &scene,
             &look(distance),
@@ -148,6 +174,7 @@ fn albedo_textures_match_the_cpu_twin_magnified_and_minified() {
                 ..s
             },
             (128, 128),
+            &indirect,
         );
         let (diff, _, _) = compare(&got, &clay, 6);
         eprintln!("{what}: the clay view differs by {diff:.2}/255");
