@@ -109,4 +109,33 @@ fn dabrovic_sponza_per_object_light_matches_mitsuba() {
     let rms = (squares.iter().sum::<f64>() / squares.len() as f64).sqrt();
     eprintln!("RMS relative error of the total: {:.1} %", 100.0 * rms);
     assert!(rms < 0.10, "RMS {rms:.3}");
+
+    // The player draws the same bake with its textures, headless (the frame itself is checked
+    // against the CPU twin in tests/gpu/textures.rs): the README's view, a picture that is
+    // neither black nor washed out (median luma 41/255 at 960×540, by Pillow).
+    let frames = tmp.path().join("frames");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
+        .args([
+            out.to_str().unwrap(),
+            "--headless",
+            "--size",
+            "320x180",
+            "--camera=-10,2,-0.5,8,4,0.5,60",
+            "--exposure",
+            "2",
+            "--out",
+            frames.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let img = image::open(frames.join("frame_0000.png"))
+        .unwrap()
+        .to_luma8();
+    assert_eq!(img.dimensions(), (320, 180));
+    let mut luma: Vec<u8> = img.into_raw();
+    luma.sort_unstable();
+    let median = luma[luma.len() / 2];
+    eprintln!("player frame: median luma {median}/255");
+    assert!((20..=200).contains(&median), "median luma {median}");
 }
