@@ -13,6 +13,7 @@ pub mod export;
 pub mod exr_io;
 pub mod form_factors;
 pub mod gltf;
+pub mod gltf_materials;
 pub mod heightmap;
 pub mod horizon;
 pub mod images;

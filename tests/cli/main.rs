@@ -12,6 +12,7 @@ mod bad_inputs;
 mod cli_foundation;
 mod cli_radiosity;
 mod compress_cli;
+mod crytek_sponza;
 mod determinism;
 mod docs_images;
 mod fuzz_corpus;

@@ -189,3 +189,19 @@ pub fn player_in_window(args: &[&std::ffi::OsStr], frames: u32) -> Option<()> {
     );
     Some(())
 }
+
+/// The Khronos glTF-Validator's wrapper script (`tools/npm/validate-gltf.js`, run with node),
+/// when `make deps-npm` installed it; reports it missing otherwise (fails under CI).
+pub fn validator() -> Option<PathBuf> {
+    let script = repo().join("tools/npm/validate-gltf.js");
+    let installed = repo()
+        .join("tools/npm/node_modules/gltf-validator")
+        .is_dir();
+    let node = Command::new("node").arg("--version").output().is_ok();
+    if installed && node {
+        Some(script)
+    } else {
+        missing("the Khronos glTF-Validator (node and tools/npm/node_modules: make deps-npm)");
+        None
+    }
+}
