@@ -12,6 +12,7 @@ mod room_light;
 
 mod adaptive;
 mod alpha;
+mod alpha_embree;
 mod export_gltf;
 mod formfactors;
 mod locate;
