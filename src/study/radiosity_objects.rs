@@ -10,6 +10,14 @@
 //! from the patches (the radiosity solution itself) and through the display mesh's corners (what
 //! the player shows).
 //!
+//! A scene lit by punctual lights (a sun) is compared on the **total** irradiance, as
+//! `tests/support/mitsuba_textured.py` writes it (`{"object": {"direct": …, "indirect": …,
+//! "indirect_stderr": …, "total": …}}`): relume's light vector is then the lights' direct
+//! exitance at the patches' sample points (shadow rays, [`patch_exitance`]) plus emission, and
+//! each object's value is its mean direct irradiance ([`object_direct`], computed once: it does
+//! not depend on the patches) plus the indirect part. Objects of one name (an OBJ's three
+//! `walls`) are merged by area, as a path tracer's meter over the name sees them.
+//!
 //! An object's error is the mean over RGB of `relume / reference − 1`. Measured are the objects
 //! the reference names whose area is at least `min_area_share` of the scene's and whose reference
 //! irradiance is positive in every channel (a relative error of nothing is undefined; those are
@@ -25,6 +33,10 @@ use crate::radiosity::mesh::objects::object_light;
 use crate::radiosity::patches::adaptive::AdaptiveParams;
 use crate::radiosity::patches::voxelize::Resolution;
 use crate::radiosity::transport::Bounces;
+use crate::render::direct::{object_direct, patch_exitance};
+use crate::render::lights::GpuLight;
+use crate::render::mesh_reference::FrameSettings;
+use crate::render::raycast::RaycastScene;
 use crate::scene::Scene;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -34,14 +46,40 @@ use std::path::Path;
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceObject {
-    /// Mean irradiance over the object, per channel (W/m² or the scene's units).
-    pub mean: [f64; 3],
+    /// Mean irradiance over the object from other surfaces and emitters, per channel (W/m² or
+    /// the scene's units).
+    #[serde(default)]
+    pub mean: Option<[f64; 3]>,
     /// Standard error of `mean` (0 when the file has none).
     #[serde(default)]
     pub stderr: [f64; 3],
+    /// Mean total irradiance (punctual lights' direct light included): compared instead of
+    /// `mean` when given.
+    #[serde(default)]
+    pub total: Option<[f64; 3]>,
+    /// The parts of `total`, informative.
+    #[serde(default)]
+    pub direct: Option<[f64; 3]>,
+    #[serde(default)]
+    pub indirect: Option<[f64; 3]>,
+    /// Standard error of the indirect part (the direct part is exact up to its sampling).
+    #[serde(default)]
+    pub indirect_stderr: Option<[f64; 3]>,
     /// The object's area as the reference renderer saw it (informative).
     #[serde(default)]
     pub area: Option<f64>,
+}
+
+impl ReferenceObject {
+    /// The irradiance compared: `total` when given, else `mean`.
+    pub fn value(&self) -> [f64; 3] {
+        self.total.or(self.mean).unwrap_or_default()
+    }
+
+    /// The standard error of [`Self::value`] as far as the file gives it.
+    pub fn value_stderr(&self) -> [f64; 3] {
+        self.indirect_stderr.unwrap_or(self.stderr)
+    }
 }
 
 /// Per-object irradiance of a scene by an independent renderer.
@@ -61,9 +99,15 @@ pub fn read_reference(path: &Path) -> Result<ObjectReference> {
         return Err(Error::input(path, "the reference names no object"));
     }
     for (name, o) in &r {
-        if o.mean
+        if o.mean.is_none() && o.total.is_none() {
+            return Err(Error::input(
+                path,
+                format!("object `{name}` has neither `mean` nor `total` irradiance"),
+            ));
+        }
+        if o.value()
             .iter()
-            .chain(&o.stderr)
+            .chain(&o.value_stderr())
             .any(|v| !v.is_finite() || *v < 0.0)
         {
             return Err(Error::input(
@@ -105,32 +149,111 @@ impl ObjectsConfig {
 /// One object's error in one bake: (object, from the patches, through the display mesh's corners).
 type ObjectError = (String, f64, f64);
 
+/// The scene's punctual lights and what they give each object directly (by object name, merged
+/// by area), when the reference compares total irradiance.
+pub struct DirectLight {
+    lights: Vec<GpuLight>,
+    raycast: RaycastScene,
+    per_object: BTreeMap<String, [f64; 3]>,
+}
+
+impl DirectLight {
+    /// The direct part of `scene`'s lights, or None for a scene without punctual lights.
+    pub fn of(scene: &Scene) -> Option<Self> {
+        if scene.lights.is_empty() {
+            return None;
+        }
+        let lights: Vec<GpuLight> = scene
+            .lights
+            .iter()
+            .map(|l| GpuLight::from_light(l, 1.0, 0))
+            .collect();
+        let raycast = RaycastScene::new(scene);
+        let direct = object_direct(scene, &lights, &raycast.visible(&lights));
+        let area = object_areas(scene);
+        let per_object = by_name(scene, &area, |o| direct[o]);
+        Some(DirectLight {
+            lights,
+            raycast,
+            per_object,
+        })
+    }
+}
+
+/// Each object's area.
+fn object_areas(scene: &Scene) -> Vec<f64> {
+    let mut area = vec![0f64; scene.objects.len()];
+    for (t, &o) in scene.triangle_object.iter().enumerate() {
+        area[o as usize] += scene.triangle_area(t) as f64;
+    }
+    area
+}
+
+/// Area-weighted means of `value(object)` over the objects of each name.
+fn by_name(
+    scene: &Scene,
+    area: &[f64],
+    value: impl Fn(usize) -> [f64; 3],
+) -> BTreeMap<String, [f64; 3]> {
+    let mut sums: BTreeMap<String, (f64, [f64; 3])> = BTreeMap::new();
+    for (o, name) in scene.objects.iter().enumerate() {
+        let e = sums.entry(name.clone()).or_default();
+        let v = value(o);
+        e.0 += area[o];
+        for c in 0..3 {
+            e.1[c] += area[o] * v[c];
+        }
+    }
+    sums.into_iter()
+        .map(|(k, (a, v))| (k, v.map(|x| x / a.max(f64::MIN_POSITIVE))))
+        .collect()
+}
+
 /// A setting (errors, time, patches) and its per-object errors for one bake.
 fn object_errors(
     scene: &Scene,
     resolution: Resolution,
     reference: &ObjectReference,
     measured: &[String],
+    direct: Option<&DirectLight>,
 ) -> Result<(Setting, Vec<ObjectError>)> {
     let ff = FormFactorsKnobs::default().params();
     let b = bake_scene(scene, resolution, &ff, Bounces::Infinite)?;
-    let light = gathered(&b.transport, &emitted_exitance(&b.set));
+    let e = match direct {
+        None => emitted_exitance(&b.set),
+        Some(d) => {
+            let e = patch_exitance(
+                &b.set,
+                &d.lights,
+                &FrameSettings::default(),
+                &d.raycast.visible(&d.lights),
+            );
+            std::array::from_fn(|c| e.iter().map(|v| v[c] as f64).collect())
+        }
+    };
+    let light = gathered(&b.transport, &e);
     let per_patch: Vec<[f32; 3]> = (0..b.set.len())
         .map(|i| std::array::from_fn(|c| light[c][i] as f32))
         .collect();
     let objects = object_light(scene, &b.set, &per_patch);
-    let err = |got: [f64; 3], r: &ReferenceObject| {
-        (0..3).map(|c| got[c] / r.mean[c] - 1.0).sum::<f64>() / 3.0
+    let area = object_areas(scene);
+    let corners = by_name(scene, &area, |o| objects[o].irradiance);
+    let patches = by_name(scene, &area, |o| objects[o].irradiance_patches);
+    let err = |got: [f64; 3], name: &str| {
+        let r = reference[name].value();
+        let d = match (direct, reference[name].total) {
+            (Some(d), Some(_)) => d.per_object[name],
+            _ => [0.0; 3],
+        };
+        (0..3).map(|c| (got[c] + d[c]) / r[c] - 1.0).sum::<f64>() / 3.0
     };
     let rows: Vec<ObjectError> = measured
         .iter()
         .map(|name| {
-            let o = objects.iter().find(|o| &o.name == name).expect("checked");
-            let r = &reference[name];
             (
                 name.clone(),
-                err(o.irradiance_patches, r),
-                err(o.irradiance, r),
+                err(patches[name], name),
+                err(corners[name], name),
             )
         })
         .collect();
@@ -162,14 +285,11 @@ pub fn measured_objects(
     min_area_share: f64,
     source: &Path,
 ) -> Result<(Vec<String>, Vec<String>)> {
-    let mut area = vec![0f64; scene.objects.len()];
-    for (t, &o) in scene.triangle_object.iter().enumerate() {
-        area[o as usize] += scene.triangle_area(t) as f64;
-    }
+    let area = object_areas(scene);
     let total: f64 = area.iter().sum();
     let (mut measured, mut notes) = (Vec::new(), Vec::new());
     for (name, r) in reference {
-        let Some(k) = scene.objects.iter().position(|o| o == name) else {
+        if !scene.objects.iter().any(|o| o == name) {
             return Err(Error::input(
                 source,
                 format!(
@@ -177,15 +297,19 @@ pub fn measured_objects(
                     scene.objects.join(", ")
                 ),
             ));
-        };
-        let share = area[k] / total.max(f64::MIN_POSITIVE);
+        }
+        let named: f64 = (0..area.len())
+            .filter(|&o| &scene.objects[o] == name)
+            .map(|o| area[o])
+            .sum();
+        let share = named / total.max(f64::MIN_POSITIVE);
         if share < min_area_share {
             notes.push(format!(
                 "`{name}` ({:.2} % of the area) is under the {:.1} % measured.",
                 100.0 * share,
                 100.0 * min_area_share
             ));
-        } else if r.mean.iter().any(|&v| v <= 0.0) {
+        } else if r.value().iter().any(|&v| v <= 0.0) {
             notes.push(format!(
                 "`{name}` gets no light in the reference in some channel: a relative error is undefined there."
             ));
@@ -212,6 +336,12 @@ pub fn objects_sweep(
 ) -> Result<Sweep> {
     let (measured, skipped) =
         measured_objects(scene, reference, cfg.min_area_share, reference_name)?;
+    // Punctual lights count only against a reference of total irradiance.
+    let direct = if reference.values().any(|r| r.total.is_some()) {
+        DirectLight::of(scene)
+    } else {
+        None
+    };
     let mut targets = cfg.targets.clone();
     targets.sort_unstable();
     targets.dedup();
@@ -238,7 +368,8 @@ pub fn objects_sweep(
             ("uniform", Resolution::TargetPatches(t)),
             ("adaptive", Resolution::Adaptive(AdaptiveParams::new(t))),
         ] {
-            let (mut s, rows) = object_errors(scene, resolution, reference, &measured)?;
+            let (mut s, rows) =
+                object_errors(scene, resolution, reference, &measured, direct.as_ref())?;
             s.label = format!("{series} {t}");
             s.series = series.into();
             s.default = resolution == default_resolution;
@@ -283,6 +414,13 @@ pub fn objects_sweep(
             false,
         ),
         Column::error(
+            "RMS over objects",
+            "object_irradiance",
+            "rms",
+            Format::Percent,
+            false,
+        ),
+        Column::error(
             "worst (corners)",
             "object_irradiance_corners",
             "max",
@@ -303,7 +441,8 @@ pub fn objects_sweep(
     ));
     for (name, cells) in &table {
         let r = &reference[name];
-        let se = (0..3).map(|c| r.stderr[c] / r.mean[c]).sum::<f64>() / 3.0;
+        let (v, e) = (r.value(), r.value_stderr());
+        let se = (0..3).map(|c| e[c] / v[c]).sum::<f64>() / 3.0;
         sweep.notes.push(format!(
             "`{name}` (reference ± {:.2} %): {}",
             100.0 * se,

@@ -86,8 +86,9 @@ pub struct RadiosityArgs {
     pub patches: Option<Vec<u32>>,
     /// Per-object irradiance of the scene by an independent renderer (JSON:
     /// {"object": {"mean": [r, g, b], "stderr": [r, g, b]}, ...}, as
-    /// tests/support/mitsuba_objects.py writes it): adds the per-object sweep, uniform vs
-    /// adaptive patches
+    /// tests/support/mitsuba_objects.py writes it; or {"object": {"total": [r, g, b], ...}}
+    /// with the punctual lights' direct light included, as tests/support/mitsuba_textured.py
+    /// writes it): adds the per-object sweep, uniform vs adaptive patches
     #[arg(long, value_name = "FILE")]
     pub objects_reference: Option<PathBuf>,
     /// Sweeps to run (default: patches,estimator,bounces, and objects with --objects-reference)
