@@ -11,6 +11,7 @@
 use crate::common::{bake, data, python, require_python, text, validator};
 use serde_json::Value;
 use std::collections::BTreeMap;
+use std::path::Path;
 
 fn luminance(v: &Value) -> f64 {
     let c = |k: usize| v[k].as_f64().unwrap();
@@ -112,19 +113,30 @@ fn dabrovic_sponza_per_object_light_matches_mitsuba() {
     // The player draws the same bake with its textures, headless (the frame itself is checked
     // against the CPU twin in tests/gpu/textures.rs): the README's view, a picture that is
     // neither black nor washed out (median luma 34/255 at 960×540, by Pillow).
-    let frames = tmp.path().join("frames");
+    let median = player_median_luma(tmp.path(), &out, "-10,2,-0.5,8,4,0.5,60", "2");
+    assert!((20..=200).contains(&median), "median luma {median}");
+
+    // `export gltf` keeps the textures. 19 of the 20 materials are textured (12 images:
+    // materials share them); no mask.
+    let (report, r) = export_textured_glb(tmp.path(), &out);
+    assert_eq!(report["textured_materials"], 19, "{report}");
+    if let Some(r) = r {
+        assert!(r["textured_primitives"].as_u64().unwrap() >= 19, "{r}");
+        assert!(r["checked"].as_u64().unwrap() > 100_000, "{r}");
+        assert_eq!(r["masks"], 0, "{r}");
+    }
+}
+
+/// Draw one 320×180 headless frame of the bake `out` from `camera` (the player's `--camera`
+/// string) at `exposure`; its median luma.
+pub fn player_median_luma(tmp: &Path, out: &Path, camera: &str, exposure: &str) -> u8 {
+    let frames = tmp.join("frames");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
-        .args([
-            out.to_str().unwrap(),
-            "--headless",
-            "--size",
-            "320x180",
-            "--camera=-10,2,-0.5,8,4,0.5,60",
-            "--exposure",
-            "2",
-            "--out",
-            frames.to_str().unwrap(),
-        ])
+        .arg(out)
+        .args(["--headless", "--size", "320x180"])
+        .arg(format!("--camera={camera}"))
+        .args(["--exposure", exposure, "--out"])
+        .arg(&frames)
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", text(&o));
@@ -136,14 +148,19 @@ fn dabrovic_sponza_per_object_light_matches_mitsuba() {
     luma.sort_unstable();
     let median = luma[luma.len() / 2];
     eprintln!("player frame: median luma {median}/255");
-    assert!((20..=200).contains(&median), "median luma {median}");
+    median
+}
 
-    // `export gltf` keeps the textures: the Khronos validator accepts the file, and on every
-    // textured primitive an independent reader finds colour × factor × the embedded image's
-    // mean linear albedo = the radiance (the patches reflect the material's mean albedo).
-    let glb = tmp.path().join("sponza.glb");
+/// `export gltf` of the bake `out`: its JSON report, after the Khronos validator accepted the
+/// file with no error or warning, and the independent reader's verdict
+/// (tests/support/textured_glb.py; None without Python) after it found colour × factor × the
+/// embedded image's mean linear albedo = the radiance on every textured primitive (f32 shading
+/// and means against f64 ones: measured worst 3.4e-7 relative over the Dabrovic Sponza's
+/// 237,421 vertices, 3.9e-7 over the Crytek's 504,353; bound 1e-5).
+pub fn export_textured_glb(tmp: &Path, out: &Path) -> (Value, Option<Value>) {
+    let glb = tmp.join("lit.glb");
     let o = bake(
-        tmp.path(),
+        tmp,
         &[
             "--json",
             "export",
@@ -156,8 +173,6 @@ fn dabrovic_sponza_per_object_light_matches_mitsuba() {
     assert!(o.status.success(), "{}", text(&o));
     let report: Value = serde_json::from_slice(&o.stdout).unwrap();
     eprintln!("glTF export: {report}");
-    // 19 of the 20 materials are textured (12 images: materials share them).
-    assert_eq!(report["textured_materials"], 19, "{report}");
     if let Some(script) = validator() {
         let o = std::process::Command::new("node")
             .arg(&script)
@@ -172,16 +187,13 @@ fn dabrovic_sponza_per_object_light_matches_mitsuba() {
             "{v}"
         );
     }
-    if require_python(&["numpy", "PIL"]) {
-        let r: Value =
-            serde_json::from_str(&python(TEXTURED_GLB, &[glb.to_str().unwrap()])).unwrap();
-        eprintln!("textured primitives: {r}");
-        assert!(r["textured_primitives"].as_u64().unwrap() >= 19, "{r}");
-        assert!(r["checked"].as_u64().unwrap() > 100_000, "{r}");
-        // f32 shading and means against f64 ones: measured worst 3.4e-7 relative over 237,421
-        // vertices (the Crytek Sponza: 3.9e-7 over 504,353); bound 1e-5.
-        assert!(r["worst"].as_f64().unwrap() < 1e-5, "{r}");
+    if !require_python(&["numpy", "PIL"]) {
+        return (report, None);
     }
+    let r: Value = serde_json::from_str(&python(TEXTURED_GLB, &[glb.to_str().unwrap()])).unwrap();
+    eprintln!("textured primitives: {r}");
+    assert!(r["worst"].as_f64().unwrap() < 1e-5, "{r}");
+    (report, Some(r))
 }
 
 /// Checks a textured GLB export (tests/support/textured_glb.py).

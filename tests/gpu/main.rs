@@ -5,6 +5,8 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+#[path = "../support/fixtures.rs"]
+mod fixtures;
 #[path = "../support/gpu_twins.rs"]
 mod twins;
 

@@ -12,7 +12,7 @@ use relume::render::camera::Camera;
 use relume::render::lights::GpuLight;
 use relume::render::mesh_reference::FrameSettings;
 use relume::render::raycast::RaycastScene;
-use relume::scene::texture::{AlphaMask, Channel, Texture, TextureRef};
+use relume::scene::texture::{Texture, TextureRef};
 use relume::scene::{Light, LightKind, Material, Scene};
 
 fn sun(direction: Vec3, lux: f32) -> GpuLight {
@@ -195,29 +195,7 @@ fn masked_leaf() -> Scene {
             [40, 160, 40, if cut { 0 } else { 255 }]
         })
         .collect();
-    let r = TextureRef::new(0);
-    let mut leaf = Material::plain("leaf", [1.0; 3], [0.0; 3]);
-    leaf.albedo_texture = Some(r.clone());
-    leaf.alpha = Some(AlphaMask {
-        factor: 1.0,
-        texture: Some((r, Channel::Alpha)),
-        cutoff: 0.5,
-    });
-    let quad = |h: f32, y: f32| [[-h, y, -h], [-h, y, h], [h, y, h], [h, y, -h]];
-    let mut positions = quad(2.0, 0.0).to_vec();
-    positions.extend(quad(1.0, 1.0));
-    let uv = [[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]];
-    Scene {
-        positions,
-        triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]],
-        triangle_material: vec![0, 0, 1, 1],
-        triangle_object: vec![0, 0, 1, 1],
-        objects: vec!["floor".into(), "leaf".into()],
-        materials: vec![Material::plain("floor", [0.7; 3], [0.0; 3]), leaf],
-        uvs: [uv, uv].concat(),
-        textures: vec![Texture::from_rgba8("leaf".into(), 8, 8, texels).unwrap()],
-        ..Default::default()
-    }
+    crate::fixtures::masked_leaf_over_floor((-2.0, 4.0), 0.7, (-1.0, 2.0), 8, texels)
 }
 
 #[test]

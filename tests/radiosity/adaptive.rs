@@ -187,7 +187,7 @@ fn adaptive_patches_match_mitsuba_on_the_furnished_room() {
         let got = light.iter().find(|l| &l.name == name).unwrap();
         let r = &reference[name];
         let err = (0..3)
-            .map(|c| got.irradiance_patches[c] / r.mean[c] - 1.0)
+            .map(|c| got.irradiance_patches[c] / r.value()[c] - 1.0)
             .sum::<f64>()
             / 3.0;
         eprintln!("{name}: {:+.2} %", 100.0 * err);

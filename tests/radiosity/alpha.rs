@@ -7,8 +7,8 @@ use glam::DVec3;
 use proptest::prelude::*;
 use relume::radiosity::geometry::Frame;
 use relume::raytrace::visibility::Visibility;
-use relume::scene::texture::{AlphaMask, Channel, Texture, TextureRef};
-use relume::scene::{Material, Scene};
+use relume::scene::texture::AlphaMask;
+use relume::scene::Scene;
 
 const N: u32 = 8;
 
@@ -19,29 +19,7 @@ fn masked_scene(bits: u64) -> Scene {
     let texels = (0..N * N)
         .flat_map(|i| [90, 90, 90, if bits >> i & 1 == 1 { 255 } else { 0 }])
         .collect();
-    let mask = TextureRef::new(0);
-    let mut masked = Material::plain("leaf", [0.5; 3], [0.0; 3]);
-    masked.albedo_texture = Some(mask.clone());
-    masked.alpha = Some(AlphaMask {
-        factor: 1.0,
-        texture: Some((mask, Channel::Alpha)),
-        cutoff: 0.5,
-    });
-    let quad = |y: f32| [[0.0, y, 0.0], [0.0, y, 4.0], [4.0, y, 4.0], [4.0, y, 0.0]];
-    let mut positions = quad(0.0).to_vec();
-    positions.extend(quad(1.0));
-    let uv = [[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]];
-    Scene {
-        positions,
-        triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]],
-        triangle_material: vec![0, 0, 1, 1],
-        triangle_object: vec![0, 0, 1, 1],
-        objects: vec!["floor".into(), "leaf".into()],
-        materials: vec![Material::plain("floor", [0.5; 3], [0.0; 3]), masked],
-        uvs: [uv, uv].concat(),
-        textures: vec![Texture::from_rgba8("mask".into(), N, N, texels).unwrap()],
-        ..Default::default()
-    }
+    crate::fixtures::masked_leaf_over_floor((0.0, 4.0), 0.5, (0.0, 4.0), N, texels)
 }
 
 fn visibility(scene: &Scene) -> Visibility {

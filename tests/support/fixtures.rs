@@ -131,3 +131,47 @@ pub fn thin_wall_rooms(t: f64) -> Scene {
     );
     s.build()
 }
+
+/// A square floor at y = 0 (`floor` = (lowest x and z, side), albedo `floor_albedo`) and above
+/// it, at y = 1, a square leaf (`leaf` = (lowest x and z, side)) whose texture (`texels`, `n`×`n`
+/// RGBA8, factor 1) cuts it away where alpha is below 0.5; the leaf's u runs along x and v
+/// along z, one image over the square.
+pub fn masked_leaf_over_floor(
+    floor: (f32, f32),
+    floor_albedo: f32,
+    leaf: (f32, f32),
+    n: u32,
+    texels: Vec<u8>,
+) -> Scene {
+    use relume::scene::texture::{AlphaMask, Channel, Texture, TextureRef};
+    use relume::scene::Material;
+    let r = TextureRef::new(0);
+    let mut masked = Material::plain("leaf", [1.0; 3], [0.0; 3]);
+    masked.albedo_texture = Some(r.clone());
+    masked.alpha = Some(AlphaMask {
+        factor: 1.0,
+        texture: Some((r, Channel::Alpha)),
+        cutoff: 0.5,
+    });
+    let quad = |(lo, side): (f32, f32), y: f32| {
+        let hi = lo + side;
+        [[lo, y, lo], [lo, y, hi], [hi, y, hi], [hi, y, lo]]
+    };
+    let mut positions = quad(floor, 0.0).to_vec();
+    positions.extend(quad(leaf, 1.0));
+    let uv = [[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]];
+    Scene {
+        positions,
+        triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]],
+        triangle_material: vec![0, 0, 1, 1],
+        triangle_object: vec![0, 0, 1, 1],
+        objects: vec!["floor".into(), "leaf".into()],
+        materials: vec![
+            Material::plain("floor", [floor_albedo; 3], [0.0; 3]),
+            masked,
+        ],
+        uvs: [uv, uv].concat(),
+        textures: vec![Texture::from_rgba8("leaf".into(), n, n, texels).unwrap()],
+        ..Default::default()
+    }
+}
