@@ -255,7 +255,7 @@ pub fn build_glb(
     let (mut views, mut accessors, mut meshes, mut nodes) = (vec![], vec![], vec![], vec![]);
     let mut push_view = |bin: &mut Vec<u8>, bytes: Vec<u8>, target: Option<u32>| -> usize {
         // Accessor data stays 4-byte aligned after images of any length.
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let offset = bin.len();

@@ -200,8 +200,8 @@ fn by_name(
         let e = sums.entry(name.clone()).or_default();
         let v = value(o);
         e.0 += area[o];
-        for c in 0..3 {
-            e.1[c] += area[o] * v[c];
+        for (acc, x) in e.1.iter_mut().zip(v) {
+            *acc += area[o] * x;
         }
     }
     sums.into_iter()
