@@ -6,7 +6,7 @@
 
 use crate::baked::images::{self, is_exr, is_tiff};
 use crate::error::{Error, Result};
-use crate::heightmap::georef::{write_geotiff_f32, write_geotiff_u8};
+use crate::heightmap::georef::{write_geotiff_f32_with, write_geotiff_u8_with, TiffCompression};
 use crate::heightmap::{HeightMap, HeightMapInfo};
 use crate::render::tonemap::linear_to_srgb8;
 use crate::terrain::hard::relief;
@@ -23,33 +23,43 @@ pub fn is_nodata(info: &HeightMapInfo, i: usize) -> bool {
 }
 
 /// Write a hard-shadow mask (`true` = in shadow, one per texel of `map`): a GeoTIFF u8 (255 lit,
-/// 0 shadow, 128 no-data) or a PNG (255 lit, 0 shadow).
+/// 0 shadow, 128 no-data; compressed by `compress`) or a PNG (255 lit, 0 shadow).
 pub fn write_shadow_mask(
     path: &Path,
     map: &HeightMap,
     info: &HeightMapInfo,
     mask: &[bool],
+    compress: TiffCompression,
 ) -> Result<()> {
     if is_tiff(path) {
         let px = masked(info, mask.len(), 128u8, |i| if mask[i] { 0 } else { 255 });
         let georef = info.georef.as_ref();
-        write_geotiff_u8(path, map.width, map.height, &px, georef, Some(128))
+        write_geotiff_u8_with(
+            path,
+            map.width,
+            map.height,
+            &px,
+            georef,
+            Some(128),
+            compress,
+        )
     } else {
         let pixels: Vec<u8> = mask.iter().map(|&s| if s { 0 } else { 255 }).collect();
         images::write_png_gray8(path, map.width, map.height, pixels)
     }
 }
 
-/// Write a lit fraction in [0, 1] per texel of `map`: a GeoTIFF f32 (no-data −1), an EXR (f32)
-/// or a 16-bit PNG (65535 = fully lit).
+/// Write a lit fraction in [0, 1] per texel of `map`: a GeoTIFF f32 (no-data −1; compressed by
+/// `compress`), an EXR (f32) or a 16-bit PNG (65535 = fully lit).
 pub fn write_lit_fraction(
     path: &Path,
     map: &HeightMap,
     info: &HeightMapInfo,
     lit: &[f32],
+    compress: TiffCompression,
 ) -> Result<()> {
     if is_tiff(path) {
-        write_tiff_f32(path, map, info, lit, -1.0)
+        write_tiff_f32(path, map, info, lit, -1.0, compress)
     } else if is_exr(path) {
         images::write_exr_gray(path, map.width, map.height, lit)
     } else {
@@ -62,17 +72,18 @@ pub fn write_lit_fraction(
 }
 
 /// Write a float raster over `map` (one value per texel): an EXR as is, else a GeoTIFF f32 with
-/// the input's georeference and no-data texels as [`NODATA`].
+/// the input's georeference and no-data texels as [`NODATA`], compressed by `compress`.
 pub fn write_float_raster(
     path: &Path,
     map: &HeightMap,
     info: &HeightMapInfo,
     v: &[f32],
+    compress: TiffCompression,
 ) -> Result<()> {
     if is_exr(path) {
         return images::write_exr_gray(path, map.width, map.height, v);
     }
-    write_tiff_f32(path, map, info, v, NODATA as f32)
+    write_tiff_f32(path, map, info, v, NODATA as f32, compress)
 }
 
 /// `value(i)` for each of the `n` texels, `nodata` where the input had no data.
@@ -94,20 +105,23 @@ fn write_tiff_f32(
     info: &HeightMapInfo,
     v: &[f32],
     nodata: f32,
+    compress: TiffCompression,
 ) -> Result<()> {
     let v = masked(info, v.len(), nodata, |i| v[i]);
-    let georef = info.georef.as_ref();
-    write_geotiff_f32(path, map.width, map.height, &v, georef, Some(nodata as f64))
+    let (georef, nodata) = (info.georef.as_ref(), Some(nodata as f64));
+    write_geotiff_f32_with(path, map.width, map.height, &v, georef, nodata, compress)
 }
 
 /// Write one horizon-angle GeoTIFF per azimuth of `hm` (degrees, f32) into `dir` (created if
-/// missing), named `horizon_AAA.AAA.tif` by the direction's exact azimuth; the files are encoded
-/// in parallel on rayon's pool (`-j`), each byte-identical to a sequential write.
+/// missing), named `horizon_AAA.AAA.tif` by the direction's exact azimuth, compressed by
+/// `compress`; the files are encoded in parallel on rayon's pool (`-j`), each byte-identical to a
+/// sequential write.
 pub fn write_horizon_planes(
     dir: &Path,
     map: &HeightMap,
     info: &HeightMapInfo,
     hm: &HorizonMap,
+    compress: TiffCompression,
 ) -> Result<()> {
     use rayon::prelude::*;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create directory", e))?;
@@ -120,7 +134,7 @@ pub fn write_horizon_planes(
         .map(|(d, plane)| {
             let v: Vec<f32> = plane.iter().map(|&q| decode(q) as f32).collect();
             let p = dir.join(format!("horizon_{:07.3}.tif", d.azimuth_deg));
-            write_float_raster(&p, map, info, &v)
+            write_float_raster(&p, map, info, &v, compress)
         })
         .collect();
     results.into_iter().collect()

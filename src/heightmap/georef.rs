@@ -1,16 +1,20 @@
 //! GeoTIFF georeference: read a height map's GeoTIFF tags, interpret the CRSs relume understands
 //! (lat/lon, UTM), and write single-band GeoTIFFs (shadow masks, lit fractions, horizon maps...)
-//! carrying the input's tags unchanged: Deflate (level 6; horizontal predictor for u8, none for
-//! f32), little-endian strips, BigTIFF past 2 GiB of samples. Texel (column j, row i) covers
+//! carrying the input's tags unchanged ([`super::geotiff_write`], re-exported here: compression
+//! by choice, horizontal predictor for compressed u8, none for f32; little-endian strips, BigTIFF
+//! past 2 GiB of samples). Texel (column j, row i) covers
 //! [j, j+1) × [i, i+1) in texel space, its centre at +0.5; row 0 is the file's first (north).
 
 use super::utm::{self, WGS84_A, WGS84_E2};
 use crate::error::{Error, Result}; // the same path in relume and in the scratch stand-in
-use std::io::{Read, Seek, Write};
+use std::io::{Read, Seek};
 use std::path::Path;
 use tiff::decoder::{ifd::Value, Decoder};
-use tiff::encoder::{colortype, Compression, DeflateLevel, Predictor};
-use tiff::encoder::{TiffEncoder, TiffKind, TiffKindBig, TiffKindStandard, TiffValue};
+
+pub use super::geotiff_write::{
+    write_geotiff_f32, write_geotiff_f32_with, write_geotiff_u8, write_geotiff_u8_with,
+    TiffCompression,
+};
 use tiff::tags::Tag;
 use tiff::TiffResult;
 
@@ -261,126 +265,6 @@ pub fn read_georeference(path: &Path) -> Result<Option<GeoReference>> {
         tiff::TiffError::UnsupportedError(u) => Error::unsupported(path, format!("TIFF: {u}")),
         other => Error::input(path, format!("cannot decode TIFF: {other}")),
     })
-}
-
-/// Writes a single-band float32 GeoTIFF atomically: to a temporary file beside `path`
-/// (`.NAME.relume-tmp-PID`), then rename, removing the temporary on any error. Carries `georef`'s
-/// tags unchanged (GeoAsciiParams characters TIFF ASCII cannot hold become `?`), and GDAL_NODATA
-/// (tag 42113, ASCII) when `nodata` is given. Deflate-compressed. Row 0 = north, as read.
-pub fn write_geotiff_f32(
-    path: &Path,
-    width: usize,
-    height: usize,
-    values: &[f32],
-    georef: Option<&GeoReference>,
-    nodata: Option<f64>,
-) -> Result<()> {
-    // The shortest decimal that reads back the same ("-9999", "NaN", "inf"; never an exponent).
-    let nodata = nodata.map(|v| v.to_string());
-    let p = Predictor::None; // tiff 0.10 cannot write the floating-point predictor
-    write::<colortype::Gray32Float>(path, [width, height], values, georef, nodata, p)
-}
-
-/// The same for u8 (masks: 0 shadow, 255 lit, and a nodata value such as 1 or 128 chosen by the
-/// caller).
-pub fn write_geotiff_u8(
-    path: &Path,
-    width: usize,
-    height: usize,
-    values: &[u8],
-    georef: Option<&GeoReference>,
-    nodata: Option<u8>,
-) -> Result<()> {
-    let (nodata, p) = (nodata.map(|v| v.to_string()), Predictor::Horizontal);
-    write::<colortype::Gray8>(path, [width, height], values, georef, nodata, p)
-}
-
-/// Checks the sizes, encodes to the temporary file, syncs it and renames it onto `path`; the
-/// temporary is removed on any error.
-fn write<C: colortype::ColorType>(
-    path: &Path,
-    size: [usize; 2],
-    values: &[C::Inner],
-    georef: Option<&GeoReference>,
-    nodata: Option<String>,
-    p: Predictor,
-) -> Result<()>
-where
-    [C::Inner]: TiffValue,
-{
-    let ([w, h], n, shown) = (size, values.len(), path.display());
-    if w == 0 || h == 0 || u32::try_from(w.max(h)).is_err() || w.checked_mul(h) != Some(n) {
-        let msg = format!("{shown}: {n} values for a {w}x{h} GeoTIFF (sides: 1 to 2^32 - 1)");
-        return Err(Error::knob(msg));
-    }
-    let Some(name) = path.file_name() else {
-        return Err(Error::knob(format!("{shown}: not a file path")));
-    };
-    let pid = std::process::id();
-    let tmp = path.with_file_name(format!(".{}.relume-tmp-{pid}", name.to_string_lossy()));
-    let io = |e| Error::io(path, "cannot write GeoTIFF", e);
-    let result = (|| {
-        let file = std::fs::File::create(&tmp).map_err(io)?;
-        let mut out = std::io::BufWriter::new(file);
-        let nodata = nodata.as_deref();
-        let encoded = match std::mem::size_of_val(values) > 1 << 31 {
-            // BigTIFF when the offsets may pass 4 GiB
-            true => encode::<_, TiffKindBig, C>(&mut out, size, values, georef, nodata, p),
-            false => encode::<_, TiffKindStandard, C>(&mut out, size, values, georef, nodata, p),
-        };
-        encoded.map_err(|e| match e {
-            tiff::TiffError::IoError(e) => io(e),
-            other => Error::unsupported(path, format!("cannot encode GeoTIFF: {other}")),
-        })?;
-        let file = out.into_inner().map_err(|e| io(e.into_error()))?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&tmp, path).map_err(io)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-fn encode<W: Write + Seek, K: TiffKind, C: colortype::ColorType>(
-    out: W,
-    [w, h]: [usize; 2],
-    values: &[C::Inner],
-    georef: Option<&GeoReference>,
-    nodata: Option<&str>,
-    p: Predictor,
-) -> TiffResult<()>
-where
-    [C::Inner]: TiffValue,
-{
-    let mut enc = TiffEncoder::<W, K>::new_generic(out)?.with_predictor(p);
-    enc = enc.with_compression(Compression::Deflate(DeflateLevel::Balanced));
-    let mut image = enc.new_image::<C>(w as u32, h as u32)?;
-    let dir = image.encoder(); // tags written here join the image's directory
-    if let Some(g) = georef {
-        for (tag, v) in [
-            (Tag::ModelPixelScaleTag, &g.pixel_scale),
-            (Tag::ModelTiepointTag, &g.tiepoints),
-            (Tag::ModelTransformationTag, &g.transformation),
-            (Tag::GeoDoubleParamsTag, &g.geo_doubles),
-        ] {
-            if !v.is_empty() {
-                dir.write_tag(tag, &v[..])?; // [f64] is written as DOUBLE
-            }
-        }
-        if !g.geo_keys.is_empty() {
-            dir.write_tag(Tag::GeoKeyDirectoryTag, &g.geo_keys[..])?; // [u16]: SHORT
-        }
-        if !g.geo_ascii.is_empty() {
-            let ascii = |c: char| if c.is_ascii() && c != '\0' { c } else { '?' };
-            let text: String = g.geo_ascii.chars().map(ascii).collect();
-            dir.write_tag(Tag::GeoAsciiParamsTag, text.as_str())?; // str: ASCII + NUL
-        }
-    }
-    if let Some(text) = nodata {
-        dir.write_tag(Tag::GdalNodata, text)?;
-    }
-    image.write_data(values)
 }
 
 #[cfg(test)]

@@ -167,3 +167,88 @@ fn geotiff_masks_keep_the_georeference_and_the_nodata() {
     let reported = v["shadowed_fraction"].as_f64().unwrap();
     assert!((frac - reported).abs() < 1e-12, "{frac} vs {reported}");
 }
+
+/// `--compress none|lzw|deflate|deflate-small`: rasterio (GDAL) reads every plane of every
+/// choice with the compression it names and the same values as the uncompressed file, and the
+/// shadow mask (u8, horizontal differencing) likewise.
+#[test]
+fn every_geotiff_compression_reads_back_the_same_values_in_gdal() {
+    if !require_python(&["rasterio", "numpy"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let srtm = data("scenes/dem/srtm_bigtujunga_30m.tif");
+    let choices = ["none", "lzw", "deflate", "deflate-small"];
+    for c in choices {
+        let out = dir.path().join(c);
+        let o = bake(
+            dir.path(),
+            &[
+                "-q",
+                "horizon",
+                s(&srtm),
+                "--directions",
+                "4",
+                "--compress",
+                c,
+                "--out",
+                s(&out),
+            ],
+        );
+        expect_code(&o, 0);
+        let mask = dir.path().join(format!("mask-{c}.tif"));
+        let o = bake(
+            dir.path(),
+            &[
+                "-q",
+                "shadow",
+                s(&srtm),
+                "--sun-azimuth",
+                "300",
+                "--sun-elevation",
+                "10",
+                "--compress",
+                c,
+                "--out",
+                s(&mask),
+            ],
+        );
+        expect_code(&o, 0);
+    }
+    let script = r#"
+import glob, json, os, sys
+import numpy as np, rasterio
+d = sys.argv[1]
+def read(p):
+    with rasterio.open(p) as s:
+        return (s.compression.value if s.compression else 'NONE'), s.read(1)
+out = {}
+for c in ['none', 'lzw', 'deflate', 'deflate-small']:
+    planes = sorted(glob.glob(os.path.join(d, c, 'horizon_*.tif')))
+    names = [os.path.basename(p) for p in planes]
+    got = [read(p) for p in planes] + [read(os.path.join(d, 'mask-%s.tif' % c))]
+    out[c] = {'names': names, 'compression': sorted({g[0] for g in got}),
+              'values': [g[1] for g in got]}
+ref = out['none']['values']
+print(json.dumps({c: {'names': v['names'], 'compression': v['compression'],
+                      'same': all(np.array_equal(a, b, equal_nan=True) for a, b in zip(v['values'], ref))}
+                  for c, v in out.items()}))
+"#;
+    let j: serde_json::Value = serde_json::from_str(&python(script, &[s(dir.path())])).unwrap();
+    eprintln!("{j}");
+    let want = [
+        ("none", "NONE"),
+        ("lzw", "LZW"),
+        ("deflate", "DEFLATE"),
+        ("deflate-small", "DEFLATE"),
+    ];
+    for (c, method) in want {
+        assert_eq!(j[c]["names"].as_array().unwrap().len(), 4, "{c}: {j}");
+        assert_eq!(j[c]["names"], j["none"]["names"], "{c}");
+        assert_eq!(j[c]["compression"], serde_json::json!([method]), "{c}: {j}");
+        assert_eq!(
+            j[c]["same"], true,
+            "{c}: values differ from the uncompressed file"
+        );
+    }
+}

@@ -7,6 +7,7 @@ use clap::{Args, ValueEnum};
 use relume::baked::images::{self, check_extension};
 use relume::baked::rasters;
 use relume::error::exit;
+use relume::heightmap::georef::TiffCompression;
 use relume::heightmap::{HeightMap, HeightMapInfo};
 use relume::pipeline::knobs;
 use relume::progress::Progress;
@@ -58,6 +59,9 @@ pub struct ShadowArgs {
     /// Shadow mask to write (.png or GeoTIFF .tif: 255 = lit, 0 = shadow, .tif 128 = no-data)
     #[arg(long, value_name = "MASK.png|MASK.tif")]
     pub out: PathBuf,
+    /// GeoTIFF compression (none: fastest, largest; deflate-small: smallest, slowest)
+    #[arg(long, value_enum, value_name = "HOW", default_value_t = crate::horizon::DEFAULT_COMPRESS)]
+    pub compress: TiffCompression,
     #[command(flatten)]
     pub relief: ReliefArgs,
 }
@@ -159,6 +163,9 @@ pub struct SoftShadowArgs {
     /// Lit fraction to write: .png (16-bit, 65535 = fully lit), .exr (f32) or GeoTIFF .tif (f32)
     #[arg(long, value_name = "LIT.png|LIT.exr|LIT.tif")]
     pub out: PathBuf,
+    /// GeoTIFF compression (none: fastest, largest; deflate-small: smallest, slowest)
+    #[arg(long, value_enum, value_name = "HOW", default_value_t = crate::horizon::DEFAULT_COMPRESS)]
+    pub compress: TiffCompression,
     #[command(flatten)]
     pub relief: ReliefArgs,
 }
@@ -190,7 +197,7 @@ pub fn softshadow(args: &SoftShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Re
     let t0 = Instant::now();
     let lit = soft_shadow_map(&map, &sun, &params, None, ui)?;
     let seconds = t0.elapsed().as_secs_f64();
-    rasters::write_lit_fraction(&args.out, &map, &info, &lit)?;
+    rasters::write_lit_fraction(&args.out, &map, &info, &lit, args.compress)?;
     if args.relief.shaded.is_some() {
         let shadow: Vec<f32> = lit.iter().map(|l| 1.0 - l).collect();
         args.relief.write(&map, &sun, &shadow)?;
@@ -249,7 +256,7 @@ pub fn shadow(args: &ShadowArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i32
     let t0 = Instant::now();
     let mask = relief::shadow_mask(&map, &sun, method, None, ui);
     let seconds = t0.elapsed().as_secs_f64();
-    rasters::write_shadow_mask(&args.out, &map, &info, &mask)?;
+    rasters::write_shadow_mask(&args.out, &map, &info, &mask, args.compress)?;
     if args.relief.shaded.is_some() {
         let shadow: Vec<f32> = mask.iter().map(|&s| s as u8 as f32).collect();
         args.relief.write(&map, &sun, &shadow)?;
