@@ -112,7 +112,7 @@ pub fn lit_patches(dir: &Path, setup: &LitExport) -> Result<LitPatches> {
         .map(|l| GpuLight::from_light(l, 1.0, 0))
         .collect();
     let s = &setup.settings;
-    let raycast = RaycastScene::new(&scene);
+    let raycast = RaycastScene::for_visibility(&scene);
     let e = patch_exitance(&set, &gpu_lights, s, &raycast.visible(&gpu_lights));
     let n = set.patches.len();
     let (b, transport) = if manifest.file(super::transport::FILE).is_some() {

@@ -25,13 +25,25 @@ pub struct RaycastScene {
     /// Per-corner texture coordinates, the material of each triangle, and the maps.
     uvs: Vec<f32>,
     triangle_material: Vec<u32>,
-    maps: SceneMaps,
+    /// None when built [`RaycastScene::for_visibility`]: frames then show mean albedos.
+    maps: Option<SceneMaps>,
 }
 
 impl RaycastScene {
     /// Build the BVH over the same (lifted) corner positions the GPU draws; alpha-masked
-    /// materials keep their masks, so shadow rays pass through cut-out texels.
+    /// materials keep their masks, so shadow rays pass through cut-out texels; and the texture
+    /// mip chains [`RaycastScene::render`] reads.
     pub fn new(scene: &Scene) -> Self {
+        RaycastScene {
+            maps: Some(SceneMaps::new(scene, u32::MAX)),
+            ..Self::for_visibility(scene)
+        }
+    }
+
+    /// [`RaycastScene::new`] without the texture mip chains, for callers that only ask
+    /// [`RaycastScene::visible`] (lit exports, per-object direct light): [`RaycastScene::render`]
+    /// then shows each material's mean albedo.
+    pub fn for_visibility(scene: &Scene) -> Self {
         let verts = corner_vertices(scene);
         let corners = verts.len() / 12;
         let masked = scene.materials.iter().any(|m| m.alpha.is_some());
@@ -88,7 +100,7 @@ impl RaycastScene {
             extent,
             uvs: corner_uvs(scene),
             triangle_material: scene.triangle_material.clone(),
-            maps: SceneMaps::new(scene, u32::MAX),
+            maps: None,
         }
     }
 
@@ -105,7 +117,8 @@ impl RaycastScene {
         corners: [Vec3; 3],
     ) -> Option<Vec3> {
         let m = self.triangle_material[t] as usize;
-        let (tw, th) = self.maps.base_size(m)?;
+        let maps = self.maps.as_ref()?;
+        let (tw, th) = maps.base_size(m)?;
         let [a, b, c] = corners;
         let uv_at = |q: Vec3| {
             let w = barycentric(q, a, b, c);
@@ -120,17 +133,17 @@ impl RaycastScene {
             (den.abs() > 0.0).then(|| o + d * (n.dot(a - o) / den))
         };
         let uv = uv_at(p);
-        let look = self.maps.materials[m]
+        let look = maps.materials[m]
             .albedo
             .as_ref()
             .map(|(_, l)| l)
-            .or(self.maps.materials[m].mask.as_ref().map(|(_, l, _)| l))?;
+            .or(maps.materials[m].mask.as_ref().map(|(_, l, _)| l))?;
         let image = |q: Vec3| look.apply(uv_at(q)) - look.apply(uv);
         let lod = match (on_plane(x + 1, y), on_plane(x, y + 1)) {
             (Some(qx), Some(qy)) => level_of_detail(image(qx), image(qy), tw, th),
             _ => 0.0,
         };
-        self.maps.albedo_at(m, uv, lod)
+        maps.albedo_at(m, uv, lod)
     }
 
     /// Per-corner vertex data the scene was built from ([`corner_vertices`]: 12 floats per

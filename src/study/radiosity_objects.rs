@@ -168,7 +168,7 @@ impl DirectLight {
             .iter()
             .map(|l| GpuLight::from_light(l, 1.0, 0))
             .collect();
-        let raycast = RaycastScene::new(scene);
+        let raycast = RaycastScene::for_visibility(scene);
         let direct = object_direct(scene, &lights, &raycast.visible(&lights));
         let area = object_areas(scene);
         let per_object = by_name(scene, &area, |o| direct[o]);
