@@ -148,6 +148,7 @@ fn main() {
                         exposure: 2.0,
                         ..Default::default()
                     },
+                    exposure: relume::render::exposure::Exposure::Fixed(2.0),
                     options: PlayerOptions::default(),
                 };
                 let report = render_frames(&gpu, &plan).expect("frames");

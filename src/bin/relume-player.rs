@@ -9,6 +9,7 @@ use relume::pipeline::checks::arg as args;
 use relume::player::headless::{render_frames, HeadlessPlan};
 use relume::player::{PlayerOptions, Sun, TransportChoice};
 use relume::render::camera::Camera;
+use relume::render::exposure::Exposure;
 use relume::render::mesh_reference::FrameSettings;
 use relume::scene::light_spec::parse_light;
 use relume::scene::Light;
@@ -18,7 +19,7 @@ const KEYS: &str = "\
 Window keys: mouse drag or arrows orbit, wheel or +/- zoom, J/L sun azimuth, I/K sun elevation,
 S sun on/off, 1 direct, 2 indirect, 3 shadows, 4 emission, 5 soft shadows, 6 fog, 7 terrain
 hard shadows from horizon maps / by traversal, 8 themes, 9 theme-border animation, 0 next
-atmosphere model (fog per vertex, fog per pixel, Hillaire), [ ] exposure,
+atmosphere model (fog per vertex, fog per pixel, Hillaire), [ ] exposure (automatic:\ncompensation in stops), X automatic exposure on/off,
 Esc quit. Headless, frame K of --frames N shows the theme borders of animation frame K.";
 
 fn after_help() -> String {
@@ -62,9 +63,10 @@ struct Cli {
     /// Graphics API (default: WGPU_BACKEND, else Vulkan then GL)
     #[arg(long, value_enum)]
     backend: Option<BackendChoice>,
-    /// Exposure (multiplies radiance before tone mapping)
-    #[arg(long, default_value_t = 1.0)]
-    exposure: f32,
+    /// Fixed exposure (multiplies radiance before tone mapping). Default: automatic, from the
+    /// frame's log-average luminance (headless: found once on frame 0 and kept)
+    #[arg(long, value_name = "X", value_parser = args::positive_f32)]
+    exposure: Option<f32>,
     /// Multiplier of the emitters' radiance (e.g. the Cornell box light)
     #[arg(long, default_value_t = 1.0)]
     emission: f32,
@@ -130,7 +132,6 @@ fn main() {
 
 fn settings(cli: &Cli) -> FrameSettings {
     FrameSettings {
-        exposure: cli.exposure,
         emission_scale: cli.emission,
         direct: !cli.no_direct,
         indirect: !cli.no_indirect,
@@ -143,6 +144,10 @@ fn settings(cli: &Cli) -> FrameSettings {
         theme_animation: !cli.no_theme_animation,
         ..Default::default()
     }
+}
+
+fn exposure(cli: &Cli) -> Exposure {
+    cli.exposure.map_or_else(Exposure::default, Exposure::Fixed)
 }
 
 fn player_options(cli: &Cli) -> PlayerOptions {
@@ -160,6 +165,7 @@ fn run(cli: &Cli) -> Result<()> {
             sun: cli.sun,
             camera: cli.camera,
             settings: settings(cli),
+            exposure: exposure(cli),
             backend: cli.backend,
             options: player_options(cli),
             lights: cli.light.clone(),
@@ -182,6 +188,7 @@ fn run(cli: &Cli) -> Result<()> {
         lights: cli.light.clone(),
         camera: cli.camera,
         settings: settings(cli),
+        exposure: exposure(cli),
         options: player_options(cli),
     };
     render_frames(&gpu, &plan)?;

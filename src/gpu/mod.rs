@@ -9,6 +9,7 @@ pub mod atmosphere;
 pub mod blit;
 pub mod compressed_gather;
 pub mod compute;
+pub mod exposure;
 pub mod freeform_caster;
 pub mod freeform_shader;
 pub mod mesh_materials;
@@ -190,6 +191,7 @@ pub const SHADERS: &[(&str, &str)] = shaders![
     "common.wgsl",
     "corner_interpolate.wgsl",
     "direct_light.wgsl",
+    "exposure_histogram.wgsl",
     "freeform.wgsl",
     "freeform_affine.wgsl",
     "freeform_shade.wgsl",

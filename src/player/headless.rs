@@ -4,9 +4,11 @@
 use super::{FrameTimes, Player, PlayerOptions, Sun};
 use crate::baked::images::write_atomic;
 use crate::error::{Error, Result};
+use crate::gpu::exposure::ExposureMeter;
 use crate::gpu::timing::PassTimer;
 use crate::gpu::{AdapterReport, Gpu};
 use crate::render::camera::Camera;
+use crate::render::exposure::{self, AutoExposure, Exposure};
 use crate::render::mesh_reference::FrameSettings;
 use crate::scene::Light;
 use serde::Serialize;
@@ -25,7 +27,10 @@ pub struct HeadlessPlan {
     pub lights: Vec<Light>,
     /// Default: the player's framing of the scene.
     pub camera: Option<Camera>,
+    /// `settings.exposure` is ignored: fixed here, or found once from frame 0 and kept for
+    /// every frame (an animation does not flicker).
     pub settings: FrameSettings,
+    pub exposure: Exposure,
     pub options: PlayerOptions,
 }
 
@@ -38,6 +43,12 @@ pub struct HeadlessReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub terrain_shadows: Option<&'static str>,
     pub note: &'static str,
+    /// The exposure every frame was drawn with, and how it was set (`fixed` or `auto`).
+    pub exposure: f32,
+    pub exposure_mode: &'static str,
+    /// Automatic exposure: the frames drawn to find it (1 = the first guess held).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exposure_tries: Option<usize>,
     pub frames: Vec<FrameTimes>,
 }
 
@@ -58,14 +69,29 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
     std::fs::create_dir_all(&plan.out)
         .map_err(|e| Error::io(&plan.out, "cannot create output directory", e))?;
     let mut timer = PassTimer::new(gpu, 48);
+    let mut settings = plan.settings;
+    let (mode, tries) = match plan.exposure {
+        Exposure::Fixed(e) => {
+            settings.exposure = e;
+            ("fixed", None)
+        }
+        Exposure::Auto(a) => {
+            player.set_sun(gpu, plan.sun.map(|s| sun_of_frame(s, 0, plan.frames)))?;
+            player.set_phase(0.0);
+            player.set_frame(gpu, 0, &settings);
+            let (e, tries) = find_exposure(gpu, &mut player, &camera, &settings, &a, &mut timer)?;
+            settings.exposure = e;
+            ("auto", Some(tries))
+        }
+    };
     let mut frames = Vec::new();
     for f in 0..plan.frames {
         let sun = plan.sun.map(|s| sun_of_frame(s, f, plan.frames));
         let t0 = Instant::now();
         player.set_sun(gpu, sun)?;
         player.set_phase(f as f64 / (plan.frames.max(2) - 1) as f64);
-        player.set_frame(gpu, f, &plan.settings);
-        player.render(gpu, &camera, &plan.settings, &mut timer)?;
+        player.set_frame(gpu, f, &settings);
+        player.render(gpu, &camera, &settings, &mut timer)?;
         let cpu_ms = t0.elapsed().as_secs_f64() * 1e3;
         let gpu_ms = timer
             .read(gpu)?
@@ -85,6 +111,9 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
         size: [w, h],
         terrain_shadows: player.terrain_shadows(&plan.settings),
         note: "cpu_ms is wall time to record, submit and wait; on a software rasteriser (llvmpipe/lavapipe) these are CPU times, not GPU times",
+        exposure: settings.exposure,
+        exposure_mode: mode,
+        exposure_tries: tries,
         frames,
     };
     let json = serde_json::to_string_pretty(&report).expect("report serialises");
@@ -92,6 +121,33 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
         std::fs::write(tmp, json.as_bytes()).map_err(|e| Error::io(tmp, "cannot write", e))
     })?;
     Ok(report)
+}
+
+/// Automatic exposure for one view: draw it, measure, and draw again with the exposure the
+/// histogram asks for until two successive exposures agree within
+/// [`exposure::SETTLED_EV`] stops (at most [`exposure::MAX_TRIES`] frames). Starts from
+/// `s.exposure`. Returns the exposure and the frames drawn.
+pub fn find_exposure(
+    gpu: &Gpu,
+    player: &mut Player,
+    camera: &Camera,
+    s: &FrameSettings,
+    auto: &AutoExposure,
+    timer: &mut PassTimer,
+) -> Result<(f32, usize)> {
+    let meter = ExposureMeter::new(gpu)?;
+    let mut s = *s;
+    for tries in 1..=exposure::MAX_TRIES {
+        player.render(gpu, camera, &s, timer)?;
+        timer.read(gpu)?;
+        let next =
+            exposure::next_exposure(&player.exposure_histogram(gpu, &meter)?, s.exposure, auto);
+        if (next / s.exposure).log2().abs() <= exposure::SETTLED_EV {
+            return Ok((s.exposure, tries));
+        }
+        s.exposure = next;
+    }
+    Ok((s.exposure, exposure::MAX_TRIES))
 }
 
 pub use crate::baked::images::write_png_rgba as write_png;

@@ -85,11 +85,10 @@ impl MeshPlayer {
         Ok(p)
     }
 
-    /// A camera framing the scene from the front (−z side), 39.3° vertical field of view (the
-    /// Cornell box's published camera).
+    /// The first view ([`crate::render::first_view`]): the framing from the front when it sees
+    /// into the scene, else a viewpoint inside it.
     pub fn default_camera(&self) -> Camera {
-        let (lo, hi) = self.scene.bounds();
-        Camera::framing(lo, hi, 39.3077)
+        crate::render::first_view::first_view(&self.scene).0
     }
 
     /// Set or clear the sun (a white directional light of 3 W/m² irradiance... scaled by the

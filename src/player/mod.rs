@@ -224,6 +224,26 @@ impl Player {
         Ok(())
     }
 
+    /// The render target's size in pixels.
+    pub fn target_size(&self) -> (u32, u32) {
+        let t = match self {
+            Player::Mesh(m) => &m.renderer.target,
+            Player::Terrain(t) => &t.renderer.target,
+            Player::Freeform(f) => &f.target,
+        };
+        (t.width, t.height)
+    }
+
+    /// The log-luminance histogram of the last frame (automatic exposure).
+    pub fn exposure_histogram(
+        &self,
+        gpu: &Gpu,
+        meter: &crate::gpu::exposure::ExposureMeter,
+    ) -> Result<[u32; crate::render::exposure::BINS]> {
+        let (w, h) = self.target_size();
+        meter.histogram(gpu, self.target_view(), w, h)
+    }
+
     /// The last frame as an image.
     pub fn read_image(&self, gpu: &Gpu) -> Result<image::RgbaImage> {
         match self {

@@ -3,11 +3,13 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::blit::Blit;
+use crate::gpu::exposure::ExposureMeter;
 use crate::gpu::timing::PassTimer;
 use crate::gpu::{BackendChoice, Gpu};
 use crate::player::camera_rig::{Fly, Held, Orbit};
 use crate::player::{Player, PlayerOptions, Sun};
 use crate::render::camera::Camera;
+use crate::render::exposure::{self, Exposure};
 use crate::render::mesh_reference::FrameSettings;
 use crate::scene::Light;
 use std::path::PathBuf;
@@ -36,6 +38,7 @@ struct Running {
     frame_ms: f64,
     /// The scene's bounding-box diagonal (the fly camera's speed scale).
     diagonal: f32,
+    meter: ExposureMeter,
 }
 
 impl Running {
@@ -53,7 +56,9 @@ pub struct WindowPlan {
     pub size: (u32, u32),
     pub sun: Option<Sun>,
     pub camera: Option<Camera>,
+    /// `settings.exposure` is the first frame's when `exposure` is automatic.
     pub settings: FrameSettings,
+    pub exposure: Exposure,
     pub backend: Option<BackendChoice>,
     pub options: PlayerOptions,
     /// Punctual lights added to the scene's (`--light`).
@@ -155,11 +160,27 @@ impl App {
             "adapter: {} ({}, {})",
             gpu.info.name, gpu.info.backend, gpu.info.device_type
         );
-        let orbit =
-            Orbit::from_camera(&self.plan.camera.unwrap_or_else(|| player.default_camera()));
+        let camera = self.plan.camera.unwrap_or_else(|| player.default_camera());
+        let orbit = Orbit::from_camera(&camera);
         let blit = Blit::new(&gpu, format)?;
-        let timer = PassTimer::new(&gpu, 48);
+        let mut timer = PassTimer::new(&gpu, 48);
+        match self.plan.exposure {
+            Exposure::Fixed(e) => self.plan.settings.exposure = e,
+            Exposure::Auto(a) => {
+                // The first frame starts from the headless one-shot value; later frames follow.
+                let (e, _) = super::headless::find_exposure(
+                    &gpu,
+                    &mut player,
+                    &camera,
+                    &self.plan.settings,
+                    &a,
+                    &mut timer,
+                )?;
+                self.plan.settings.exposure = e;
+            }
+        }
         let diagonal = player.diagonal();
+        let meter = ExposureMeter::new(&gpu)?;
         Ok(Running {
             window,
             surface,
@@ -175,6 +196,7 @@ impl App {
             last_frame: Instant::now(),
             frame_ms: 0.0,
             diagonal,
+            meter,
         })
     }
 
@@ -194,6 +216,14 @@ impl App {
         let camera = r.camera();
         r.player
             .render(&r.gpu, &camera, &self.plan.settings, &mut r.timer)?;
+        if let Exposure::Auto(a) = self.plan.exposure {
+            // Follow the light: brighter in about a third of a second, darker in one.
+            let used = self.plan.settings.exposure;
+            let target =
+                exposure::next_exposure(&r.player.exposure_histogram(&r.gpu, &r.meter)?, used, &a);
+            let tau = if target > used { 1.0 } else { 0.33 };
+            self.plan.settings.exposure = exposure::smooth(used, target, dt, tau);
+        }
         let frame = match r.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f)
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -214,8 +244,15 @@ impl App {
                 Some(f) => format!("fly {:.2} m/s", f.speed),
                 None => "orbit".into(),
             };
+            let exposure = match self.plan.exposure {
+                Exposure::Auto(a) => format!(
+                    "exposure {:.3} (auto {:+.1} EV)",
+                    s.exposure, a.compensation_ev
+                ),
+                Exposure::Fixed(_) => format!("exposure {:.3}", s.exposure),
+            };
             r.window.set_title(&format!(
-                "relume-player — {:.1} ms/frame — {mode} — sun {:.0}°/{:.0}°{} — direct {} indirect {} shadows {} emission {} textures {}",
+                "relume-player — {:.1} ms/frame — {mode} — {exposure} — sun {:.0}°/{:.0}°{} — direct {} indirect {} shadows {} emission {} textures {}",
                 r.frame_ms,
                 self.sun.azimuth_deg,
                 self.sun.elevation_deg,
@@ -300,8 +337,22 @@ impl App {
                         Model::Hillaire | Model::None => Model::Fog,
                     }
                 }
-                "[" => self.plan.settings.exposure /= 1.25,
-                "]" => self.plan.settings.exposure *= 1.25,
+                "[" | "]" => {
+                    let up = c.as_str() == "]";
+                    match &mut self.plan.exposure {
+                        Exposure::Auto(a) => a.compensation_ev += if up { 1.0 } else { -1.0 } / 3.0,
+                        Exposure::Fixed(e) => {
+                            *e *= if up { 1.25 } else { 0.8 };
+                            self.plan.settings.exposure = *e;
+                        }
+                    }
+                }
+                "x" | "X" => {
+                    self.plan.exposure = match self.plan.exposure {
+                        Exposure::Auto(_) => Exposure::Fixed(self.plan.settings.exposure),
+                        Exposure::Fixed(_) => Exposure::default(),
+                    }
+                }
                 _ => {}
             },
             _ => {}

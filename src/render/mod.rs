@@ -2,6 +2,8 @@
 
 pub mod camera;
 pub mod direct;
+pub mod exposure;
+pub mod first_view;
 pub mod freeform_image;
 pub mod freeform_shade;
 pub mod lights;

@@ -214,7 +214,15 @@ fn player_vs_cpu(
     common::expect_code(&o, 0);
     let out = dir.path().join("frames");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
-        .args([scene.to_str().unwrap(), "--headless", "--size", size])
+        // The CPU render's exposure (1).
+        .args([
+            scene.to_str().unwrap(),
+            "--headless",
+            "--size",
+            size,
+            "--exposure",
+            "1",
+        ])
         .args(&sun_args)
         .args([
             "--frames",

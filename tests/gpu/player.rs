@@ -468,7 +468,16 @@ fn pipeline_lights_reach_the_bake_and_the_player() {
         }
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
             .arg(&out)
-            .args(["--headless", "--size", "160x120", "-q", "--out"])
+            // A fixed exposure: the two frames are compared by brightness.
+            .args([
+                "--headless",
+                "--size",
+                "160x120",
+                "-q",
+                "--exposure",
+                "1",
+                "--out",
+            ])
             .arg(out.join("frames"))
             .args(["--camera", "0.278,0.273,-0.8,0.278,0.273,0,39.3"])
             .output()

@@ -108,6 +108,8 @@ fn the_player_shadows_from_horizon_maps_and_matches_the_traversal_at_a_stored_az
             "160x120",
             "--sun",
             "90,6",
+            "--exposure",
+            "1",
             "--out",
             s(&dir),
         ];
