@@ -11,6 +11,7 @@ mod fixtures;
 mod twins;
 
 mod atmosphere;
+mod exposure;
 mod freeform_gpu_shade;
 mod freeform_gpu_texture;
 mod freeform_twin;

@@ -12,6 +12,7 @@ mod architecture;
 mod atmosphere;
 mod atmosphere_orders;
 mod compress_lib;
+mod first_view;
 mod freeform_mesh;
 mod freeform_mesh_texture;
 mod freeform_quadrics;
