@@ -29,7 +29,12 @@ pub struct AirFrame {
     pub model: u32,
 }
 
-/// The sky (ambient) term of the terrain's lighting.
+/// The sky (ambient) term of the terrain's lighting with the sun at the zenith. Under Hillaire's
+/// model it follows the sun's transmittance to the ground, relative to the zenith's: a clear
+/// sky's diffuse irradiance is a fixed fraction of the direct normal irradiance (the ASHRAE
+/// clear-sky model, DHI = C·DNI with DNI = A·exp(−B / sin elevation)), so a low sun dims the sky
+/// with it and the relief's lit and shadowed slopes keep their contrast. The other models light
+/// surfaces with the top-of-air sun and keep the constant.
 pub const SKY: f32 = 0.15;
 
 /// The air's uniform fields for `model` with the sun toward unit `sun` (eye frame, +Y up), the
@@ -52,15 +57,19 @@ pub fn air_frame(
             w as f32,
         ]
     };
-    let light = match model {
+    let (light, sky) = match model {
         Model::Hillaire => {
-            reference::sun_transmittance(atm, eye_position(atm, ground_altitude), sun)
+            let at = |d: DVec3| reference::sun_transmittance(atm, eye_position(atm, ground_altitude), d);
+            let luminance = |t: [f64; 3]| 0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2];
+            let light = at(sun);
+            let sky = SKY as f64 * luminance(light) / luminance(at(DVec3::Y)).max(1e-12);
+            (light, sky as f32)
         }
-        _ => [1.0; 3],
+        _ => ([1.0; 3], SKY),
     };
     let sun_light = std::array::from_fn(|c| {
         if c == 3 {
-            SKY
+            sky
         } else {
             (light[c] * atm.sun_illuminance[c]) as f32 * strength
         }

@@ -65,6 +65,8 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
     let (w, h) = plan.size;
     let mut player = Player::load(gpu, &plan.dir, &plan.options, w, h)?;
     player.add_lights(gpu, &plan.lights)?;
+    // The first view may depend on the sun (terrain): frame 0's.
+    player.set_sun(gpu, plan.sun.map(|s| sun_of_frame(s, 0, plan.frames)))?;
     let camera = plan.camera.unwrap_or_else(|| player.default_camera());
     std::fs::create_dir_all(&plan.out)
         .map_err(|e| Error::io(&plan.out, "cannot create output directory", e))?;

@@ -24,7 +24,15 @@ pub struct TerrainPlayer {
     pub settings: TerrainSettings,
     /// The bake's theme set (`themes.bin`), when it has one.
     pub themes: Option<crate::theme::ThemeSet>,
+    /// The sun of the last [`TerrainPlayer::set_sun`].
+    pub sun: Sun,
 }
+
+/// The sun when none is given.
+pub const DEFAULT_SUN: Sun = Sun {
+    azimuth_deg: 300.0,
+    elevation_deg: 10.0,
+};
 
 impl TerrainPlayer {
     /// Load `heightmap.exr`, `minmax_mipmap.exr` (built here when the bake has none) and the
@@ -71,31 +79,25 @@ impl TerrainPlayer {
             renderer,
             settings: TerrainSettings::default(),
             themes,
+            sun: DEFAULT_SUN,
         })
     }
 
-    /// A camera over the map from the south-east, looking at its centre.
+    /// A low oblique view of the map's most rugged part from the side where the current sun
+    /// shows the most relief ([`crate::render::terrain_view`]).
     pub fn default_camera(&self) -> Camera {
-        let (eye, target) = self.renderer.default_view(&self.settings);
-        let d = (eye - target).length();
-        Camera {
-            eye,
-            target,
-            up: glam::Vec3::Y,
-            fov_y_deg: 45.0,
-            near: d * 1e-3,
-            far: d * 10.0,
-        }
+        crate::render::terrain_view::relief_view(
+            &self.map,
+            &self.sun,
+            self.settings.vertical_exaggeration,
+        )
     }
 
     /// Set the sun (default: azimuth 300°, elevation 10°).
     pub fn set_sun(&mut self, gpu: &Gpu, sun: Option<Sun>) -> Result<()> {
-        let s = sun.unwrap_or(Sun {
-            azimuth_deg: 300.0,
-            elevation_deg: 10.0,
-        });
-        self.renderer
-            .set_sun(gpu, Sun::new(s.azimuth_deg, s.elevation_deg)?);
+        let s = sun.unwrap_or(DEFAULT_SUN);
+        self.sun = Sun::new(s.azimuth_deg, s.elevation_deg)?;
+        self.renderer.set_sun(gpu, self.sun);
         Ok(())
     }
 

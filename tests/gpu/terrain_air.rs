@@ -15,7 +15,7 @@ use relume::atmosphere::fog::FogParams;
 use relume::atmosphere::lut::Luts;
 use relume::atmosphere::twin::AtmosphereGpu;
 use relume::atmosphere::{Atmosphere, Model};
-use relume::gpu::terrain_air::{air_frame, SKY};
+use relume::gpu::terrain_air::air_frame;
 use relume::gpu::terrain_renderer::TerrainRenderer;
 use relume::gpu::timing::PassTimer;
 use relume::gpu::Gpu;
@@ -112,7 +112,7 @@ fn compare(gpu: &Gpu, model: Model, sun: Sun) -> (usize, usize, u8) {
                     continue; // a pixel the mesh's edge splits
                 }
                 let l0: [f64; 3] = std::array::from_fn(|c| {
-                    (albedo[c] * (air.sun_light[c] * lambert + SKY)) as f64
+                    (albedo[c] * (air.sun_light[c] * lambert + air.sun_light[3])) as f64
                 });
                 let s_m = t;
                 match &luts {
