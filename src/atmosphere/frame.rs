@@ -59,7 +59,8 @@ pub fn air_frame(
     };
     let (light, sky) = match model {
         Model::Hillaire => {
-            let at = |d: DVec3| reference::sun_transmittance(atm, eye_position(atm, ground_altitude), d);
+            let at =
+                |d: DVec3| reference::sun_transmittance(atm, eye_position(atm, ground_altitude), d);
             let luminance = |t: [f64; 3]| 0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2];
             let light = at(sun);
             let sky = SKY as f64 * luminance(light) / luminance(at(DVec3::Y)).max(1e-12);
@@ -98,6 +99,40 @@ impl Model {
             Model::Fog => 1,
             Model::FogPerPixel => 2,
             Model::Hillaire => 3,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Hillaire's sky term: the constant at the zenith, dimmer with the sun lower, in step with
+    /// the direct sun's luminance; the other models keep the constant.
+    #[test]
+    fn the_sky_term_follows_the_sun() {
+        let atm = Atmosphere::earth();
+        let sun_at = |el: f64| {
+            let e = el.to_radians();
+            DVec3::new(0.0, e.sin(), e.cos())
+        };
+        let sky = |m, el| air_frame(&atm, m, sun_at(el), 500.0, 0.0, 1.0).sun_light;
+        assert!((sky(Model::Hillaire, 90.0)[3] - SKY).abs() < 1e-6);
+        let mut last = f32::INFINITY;
+        for el in [90.0, 45.0, 20.0, 6.0, 2.0] {
+            let l = sky(Model::Hillaire, el);
+            assert!(l[3] < last || el == 90.0, "{el}°: {}", l[3]);
+            last = l[3];
+            let y = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+            let y90 = {
+                let z = sky(Model::Hillaire, 90.0);
+                0.2126 * z[0] + 0.7152 * z[1] + 0.0722 * z[2]
+            };
+            assert!(
+                (l[3] / y - SKY / y90).abs() < 1e-4,
+                "{el}°: sky/direct not constant"
+            );
+            assert_eq!(sky(Model::Fog, el)[3], SKY);
         }
     }
 }

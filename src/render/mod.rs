@@ -10,6 +10,6 @@ pub mod lights;
 pub mod material_maps;
 pub mod mesh_reference;
 pub mod raycast;
-pub mod terrain_view;
 pub mod terrain_shading;
+pub mod terrain_view;
 pub mod tonemap;

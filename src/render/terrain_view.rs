@@ -39,10 +39,11 @@ pub fn relief_view(map: &HeightMap, sun: &Sun, exaggeration: f32) -> Camera {
     let mut best = (f32::NEG_INFINITY, 0usize, 0usize);
     for r0 in (0..h).step_by(bs) {
         for c0 in (0..w).step_by(bs) {
-            let (lo, hi) = block(map, c0, r0, bs).fold((f32::INFINITY, f32::NEG_INFINITY), |a, i| {
-                let v = map.heights[i];
-                (a.0.min(v), a.1.max(v))
-            });
+            let (lo, hi) =
+                block(map, c0, r0, bs).fold((f32::INFINITY, f32::NEG_INFINITY), |a, i| {
+                    let v = map.heights[i];
+                    (a.0.min(v), a.1.max(v))
+                });
             if hi - lo > best.0 {
                 best = (hi - lo, c0, r0);
             }
@@ -50,7 +51,13 @@ pub fn relief_view(map: &HeightMap, sun: &Sun, exaggeration: f32) -> Camera {
     }
     let (_, c0, r0) = best;
     let cells: Vec<usize> = block(map, c0, r0, bs).collect();
-    let top = cells.iter().copied().fold(cells[0], |a, i| if map.heights[i] > map.heights[a] { i } else { a });
+    let top = cells.iter().copied().fold(cells[0], |a, i| {
+        if map.heights[i] > map.heights[a] {
+            i
+        } else {
+            a
+        }
+    });
     let [cx, cy] = map.cell_size;
     let world = |c: f64, r: f64, z: f64| DVec3::new((c + 0.5) * cx, z * e, (r + 0.5) * cy);
     let target = world((top % w) as f64, (top / w) as f64, map.heights[top] as f64);

@@ -71,7 +71,10 @@ fn gpu_histogram_matches_its_cpu_twin() {
         .sum::<u32>()
         / 2;
     eprintln!("pixels in another bin: {moved} of {counted}");
-    assert!(moved * 1000 <= counted, "{moved} of {counted} pixels binned differently");
+    assert!(
+        moved * 1000 <= counted,
+        "{moved} of {counted} pixels binned differently"
+    );
 }
 
 /// sRGB display value (0..=1) → linear, IEC 61966-2-1, written out here independently.
@@ -166,5 +169,8 @@ fn headless_auto_exposure_is_the_log_average_of_its_frame() {
         .output()
         .unwrap();
     let err = expect_code(&o, 2);
-    assert!(err.contains("--exposure") && err.contains("positive"), "{err}");
+    assert!(
+        err.contains("--exposure") && err.contains("positive"),
+        "{err}"
+    );
 }

@@ -57,7 +57,11 @@ fn open_boxes_and_solid_objects_keep_the_framing() {
 
 #[test]
 fn the_bundled_rooms_open_inside_their_walls() {
-    for which in [Generated::FurnishedRoom, Generated::DoorAjar, Generated::DoorSealed] {
+    for which in [
+        Generated::FurnishedRoom,
+        Generated::DoorAjar,
+        Generated::DoorSealed,
+    ] {
         let scene = generate(which);
         let (lo, hi) = scene.bounds();
         let (cam, kind) = first_view(&scene);

@@ -11,6 +11,7 @@ mod terrain_common;
 mod cli;
 mod exactness;
 mod f32;
+mod first_view;
 mod geo;
 mod horizon;
 mod horizon_bake;
