@@ -426,6 +426,9 @@ fn write_input(txn: &mut BakeTransaction, input: &LoadedInput) -> Result<StageRe
         LoadedInput::Scene(scene, _) => {
             baked::scene::write(txn, scene)?;
             rec.outputs.push(baked::scene::FILE.into());
+            if !scene.viewpoints.is_empty() {
+                rec.outputs.push(baked::scene::VIEWS_FILE.into());
+            }
             rec.report
                 .insert("vertices".into(), scene.positions.len() as f64);
             rec.report

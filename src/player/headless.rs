@@ -39,6 +39,8 @@ pub struct HeadlessPlan {
 pub struct HeadlessReport {
     pub adapter: AdapterReport,
     pub size: [u32; 2],
+    /// The view, as the `--camera` argument that gives it back.
+    pub camera: String,
     /// Terrain: how shadows were computed (`horizon_maps`, `traversal`, `soft`, `none`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub terrain_shadows: Option<&'static str>,
@@ -111,6 +113,7 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
     let report = HeadlessReport {
         adapter: gpu.info.clone(),
         size: [w, h],
+        camera: camera.to_arg(),
         terrain_shadows: player.terrain_shadows(&plan.settings),
         note: "cpu_ms is wall time to record, submit and wait; on a software rasteriser (llvmpipe/lavapipe) these are CPU times, not GPU times",
         exposure: settings.exposure,

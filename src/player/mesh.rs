@@ -28,6 +28,8 @@ pub struct MeshPlayer {
     pub sun: Option<GpuLight>,
     /// The baked light transfer, when the bake has one.
     pub radiosity: Option<(PatchSet, RadiosityRuntime)>,
+    /// The source file's cameras (glTF camera nodes).
+    pub views: Vec<crate::scene::Viewpoint>,
 }
 
 /// Shadow-map resolution.
@@ -44,6 +46,11 @@ impl MeshPlayer {
         height: u32,
     ) -> Result<Self> {
         let scene = baked::scene::read(dir)?;
+        let views = if manifest.file(baked::scene::VIEWS_FILE).is_some() {
+            baked::scene::read_views(dir)?
+        } else {
+            Vec::new()
+        };
         let has_transport = manifest.file(baked::encoded::TRANSFER_FILE).is_some()
             || manifest.file(baked::transport::FILE).is_some();
         // With baked light, draw the display mesh: triangles split to 1.5 voxels so that the
@@ -80,15 +87,32 @@ impl MeshPlayer {
             scene_lights,
             sun: None,
             radiosity,
+            views,
         };
         p.upload_lights(gpu)?;
         Ok(p)
     }
 
-    /// The first view ([`crate::render::first_view`]): the framing from the front when it sees
-    /// into the scene, else a viewpoint inside it.
+    /// The first view: the source file's first camera when it has one, else
+    /// [`crate::render::first_view`] (the framing from the front when it sees into the scene,
+    /// else a viewpoint inside it).
     pub fn default_camera(&self) -> Camera {
-        crate::render::first_view::first_view(&self.scene).0
+        match self.views.first() {
+            Some(v) => {
+                let (lo, hi) = self.scene.bounds();
+                let radius = (hi - lo).length().max(1e-6);
+                let eye = glam::Vec3::from(v.eye);
+                Camera {
+                    eye,
+                    target: v.target.into(),
+                    up: v.up.into(),
+                    fov_y_deg: v.fov_y_deg,
+                    near: (radius * 1e-3).max(1e-6),
+                    far: (eye - (lo + hi) * 0.5).length() + 2.0 * radius,
+                }
+            }
+            None => crate::render::first_view::first_view(&self.scene).0,
+        }
     }
 
     /// Set or clear the sun (a white directional light of 3 W/m² irradiance... scaled by the

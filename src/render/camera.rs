@@ -93,6 +93,14 @@ impl Camera {
         self.projection(width, height) * self.view()
     }
 
+    /// The `--camera` argument that gives this camera back (eye, target, field of view; the up
+    /// vector is +y there): `EX,EY,EZ,TX,TY,TZ,FOV`, shortest round-trip decimals.
+    pub fn to_arg(&self) -> String {
+        let [ex, ey, ez] = self.eye.to_array();
+        let [tx, ty, tz] = self.target.to_array();
+        format!("{ex},{ey},{ez},{tx},{ty},{tz},{}", self.fov_y_deg)
+    }
+
     /// The world-space ray (origin, unit direction) through the centre of pixel (x, y), row 0
     /// at the top, matching the rasteriser's pixel centres.
     pub fn ray(&self, x: u32, y: u32, width: u32, height: u32) -> (Vec3, Vec3) {

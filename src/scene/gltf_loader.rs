@@ -224,6 +224,33 @@ fn load_unguarded(path: &Path, warnings: &mut LoadWarnings) -> Result<Scene> {
                 range: light.range(),
             });
         }
+        if let Some(camera) = node.camera() {
+            let name = node
+                .name()
+                .or(camera.name())
+                .map_or_else(|| format!("camera{}", camera.index()), str::to_owned);
+            match camera.projection() {
+                gltf::camera::Projection::Perspective(p) => {
+                    let eye = world.transform_point3(Vec3::ZERO);
+                    let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+                    let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+                    if forward != Vec3::ZERO && up != Vec3::ZERO && p.yfov() > 0.0 {
+                        scene.viewpoints.push(crate::scene::Viewpoint {
+                            name,
+                            eye: eye.to_array(),
+                            target: (eye + forward).to_array(),
+                            up: up.to_array(),
+                            fov_y_deg: p.yfov().to_degrees(),
+                        });
+                    } else {
+                        warnings.push(format!("camera `{name}` has a degenerate transform or field of view; ignored"));
+                    }
+                }
+                gltf::camera::Projection::Orthographic(_) => warnings.push(format!(
+                    "camera `{name}` is orthographic; the player's cameras are perspective, so it is ignored"
+                )),
+            }
+        }
         let children: Vec<_> = node.children().map(|c| (c, world)).collect();
         stack.extend(children.into_iter().rev());
     }

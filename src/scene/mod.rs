@@ -121,6 +121,23 @@ pub struct Scene {
     pub uvs: Vec<[f32; 2]>,
     /// The images materials refer to.
     pub textures: Vec<Texture>,
+    /// Cameras the source file names (glTF camera nodes), in node order. Not part of
+    /// `scene.bin` (a bake stores them in `views.json` when there are any).
+    #[serde(skip)]
+    pub viewpoints: Vec<Viewpoint>,
+}
+
+/// A perspective camera of the source file, in world space.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Viewpoint {
+    /// The node's (or camera's) name.
+    pub name: String,
+    pub eye: [f32; 3],
+    /// A point one unit along the view direction.
+    pub target: [f32; 3],
+    pub up: [f32; 3],
+    /// Vertical field of view, degrees.
+    pub fov_y_deg: f32,
 }
 
 /// What a loader noticed but did not treat as an error.
@@ -191,6 +208,11 @@ pub fn load_scene(path: &Path, opts: SceneOptions) -> Result<(Scene, LoadWarning
                 *c *= opts.scale;
             }
             l.range = l.range.map(|r| r * opts.scale);
+        }
+        for v in &mut scene.viewpoints {
+            let forward = [0, 1, 2].map(|k| v.target[k] - v.eye[k]);
+            v.eye = v.eye.map(|c| c * opts.scale);
+            v.target = [0, 1, 2].map(|k| v.eye[k] + forward[k]);
         }
     }
     scene.validate(path)?;

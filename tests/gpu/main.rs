@@ -7,6 +7,8 @@
 mod common;
 #[path = "../support/fixtures.rs"]
 mod fixtures;
+#[path = "../support/gltf_cameras.rs"]
+mod gltf_cameras;
 #[path = "../support/gpu_twins.rs"]
 mod twins;
 

@@ -493,3 +493,54 @@ fn pipeline_lights_reach_the_bake_and_the_player() {
     eprintln!("pipeline spot: centre +{centre:.1}");
     assert!(centre > 30.0, "the pipeline's spot adds only {centre}");
 }
+
+#[test]
+fn a_gltf_camera_is_the_first_view_and_travels_in_the_bake() {
+    let tmp = tempfile::tempdir().unwrap();
+    let gltf = crate::gltf_cameras::room_with_cameras(tmp.path());
+    let pipeline = tmp.path().join("p.ron");
+    std::fs::write(
+        &pipeline,
+        format!("Pipeline(input: Scene(path: {:?}), stages: [])", gltf),
+    )
+    .unwrap();
+    let out = tmp.path().join("bake");
+    let o = bake(
+        tmp.path(),
+        &[
+            "run",
+            "-q",
+            pipeline.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    expect_code(&o, 0);
+    let views = relume::baked::scene::read_views(&out).unwrap();
+    assert_eq!(views.len(), 1);
+    if gpu().is_none() {
+        return;
+    }
+    let frames = tmp.path().join("frames");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))
+        .arg(&out)
+        .args(["--headless", "--size", "64x48", "-q", "--out"])
+        .arg(&frames)
+        .output()
+        .unwrap();
+    expect_code(&o, 0);
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(frames.join("frames.json")).unwrap()).unwrap();
+    // The node's world eye (1, 1, 2) looking along −x, yfov 0.8 rad.
+    let numbers: Vec<f32> = j["camera"]
+        .as_str()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let want = [1.0, 1.0, 2.0, 0.0, 1.0, 2.0, 0.8f32.to_degrees()];
+    assert!(
+        numbers.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-4),
+        "{numbers:?}"
+    );
+}

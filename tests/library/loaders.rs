@@ -314,3 +314,29 @@ fn nodata_policies() {
     .unwrap();
     assert_eq!(m.heights, vec![5.0, 5.0, 3.0, 5.0, 8.0, 9.0]);
 }
+
+#[test]
+fn gltf_cameras_become_viewpoints_in_world_space() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = crate::gltf_cameras::room_with_cameras(tmp.path());
+    let (scene, warnings) = load_scene(&path, SceneOptions { scale: 10.0 }).unwrap();
+    assert_eq!(scene.viewpoints.len(), 1, "{:?}", scene.viewpoints);
+    let v = &scene.viewpoints[0];
+    assert_eq!(v.name, "view");
+    // World = group (translate (0, 0.5, 0), scale 2) · view (translate (0.5, 0.25, 1), turn
+    // +90° about y): eye (1, 1, 2); −z turned +90° about y is −x. Then the scene scale ×10
+    // moves the eye, not the unit direction.
+    let close = |a: [f32; 3], b: [f32; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-4);
+    assert!(close(v.eye, [10.0, 10.0, 20.0]), "{:?}", v.eye);
+    assert!(close(v.target, [9.0, 10.0, 20.0]), "{:?}", v.target);
+    assert!(close(v.up, [0.0, 1.0, 0.0]), "{:?}", v.up);
+    assert!((v.fov_y_deg - 0.8f32.to_degrees()).abs() < 1e-4);
+    assert!(
+        warnings
+            .messages
+            .iter()
+            .any(|m| m.contains("`plan`") && m.contains("orthographic")),
+        "{:?}",
+        warnings.messages
+    );
+}

@@ -5,6 +5,8 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+#[path = "../support/gltf_cameras.rs"]
+mod gltf_cameras;
 #[path = "../support/transport_box.rs"]
 mod transport_box;
 
