@@ -16,7 +16,7 @@ use relume::scene::Light;
 use std::path::PathBuf;
 
 const KEYS: &str = "\
-Window keys: mouse drag or arrows orbit, wheel or +/- zoom, J/L sun azimuth, I/K sun elevation,
+Window keys: Tab panel on/off, F12 screenshot, mouse drag or arrows orbit, wheel or +/- zoom, J/L sun azimuth, I/K sun elevation,
 S sun on/off, 1 direct, 2 indirect, 3 shadows, 4 emission, 5 soft shadows, 6 fog, 7 terrain
 hard shadows from horizon maps / by traversal, 8 themes, 9 theme-border animation, 0 next
 atmosphere model (fog per vertex, fog per pixel, Hillaire), [ ] exposure (automatic:\ncompensation in stops), X automatic exposure on/off,
@@ -57,6 +57,13 @@ struct Cli {
     /// Window: close after N frames (for scripts and tests)
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     exit_after: Option<u32>,
+    /// Window: start with the panel hidden (Tab shows it)
+    #[arg(long)]
+    no_panel: bool,
+    /// Window: replay scripted panel input (`FRAME click LABEL`, `FRAME screenshot PNG` per
+    /// line; docs/player.md) — for tests and demos
+    #[arg(long, value_name = "FILE")]
+    panel_script: Option<PathBuf>,
     /// Camera: eye x,y,z, target x,y,z and optionally the vertical field of view in degrees
     #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]", value_parser = args::camera, allow_hyphen_values = true)]
     camera: Option<Camera>,
@@ -170,6 +177,8 @@ fn run(cli: &Cli) -> Result<()> {
             options: player_options(cli),
             lights: cli.light.clone(),
             exit_after: cli.exit_after,
+            panel_script: cli.panel_script.clone(),
+            panel: !cli.no_panel,
         });
     }
     let gpu = Gpu::new(cli.backend)?;

@@ -22,8 +22,9 @@ use std::path::Path;
 pub struct MeshPlayer {
     pub scene: Scene,
     pub renderer: MeshRenderer,
-    /// Lights of the scene file (always on).
-    pub scene_lights: Vec<GpuLight>,
+    /// Lights of the scene file and `--light`, each with whether it is on (the window's panel
+    /// edits them).
+    pub lights: Vec<(Light, bool)>,
     /// The sun, when set.
     pub sun: Option<GpuLight>,
     /// The baked light transfer, when the bake has one.
@@ -72,11 +73,7 @@ impl MeshPlayer {
             (scene, None)
         };
         let renderer = MeshRenderer::new(gpu, &scene, width, height, SHADOW_SIZE)?;
-        let scene_lights = scene
-            .lights
-            .iter()
-            .map(|l| GpuLight::from_light(l, 1.0, 0))
-            .collect();
+        let lights = scene.lights.iter().map(|l| (l.clone(), true)).collect();
         let radiosity = match set {
             Some(set) => Some(load_radiosity(gpu, dir, manifest, opts, &renderer, set)?),
             None => None,
@@ -84,7 +81,7 @@ impl MeshPlayer {
         let mut p = MeshPlayer {
             scene,
             renderer,
-            scene_lights,
+            lights,
             sun: None,
             radiosity,
             views,
@@ -122,15 +119,25 @@ impl MeshPlayer {
         self.upload_lights(gpu)
     }
 
-    /// Add punctual lights to the scene's own (always on).
+    /// Add punctual lights to the scene's own (on).
     pub fn add_lights(&mut self, gpu: &Gpu, lights: &[Light]) -> Result<()> {
-        self.scene_lights
-            .extend(lights.iter().map(|l| GpuLight::from_light(l, 1.0, 0)));
+        self.lights.extend(lights.iter().map(|l| (l.clone(), true)));
+        self.upload_lights(gpu)
+    }
+
+    /// Replace the punctual lights (each with whether it is on); the indirect light follows.
+    pub fn set_lights(&mut self, gpu: &Gpu, lights: &[(Light, bool)]) -> Result<()> {
+        self.lights = lights.to_vec();
         self.upload_lights(gpu)
     }
 
     fn upload_lights(&mut self, gpu: &Gpu) -> Result<()> {
-        let mut all = self.scene_lights.clone();
+        let mut all: Vec<GpuLight> = self
+            .lights
+            .iter()
+            .filter(|(_, on)| *on)
+            .map(|(l, _)| GpuLight::from_light(l, 1.0, 0))
+            .collect();
         all.extend(self.sun);
         self.renderer.set_lights(gpu, &all)
     }

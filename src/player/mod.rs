@@ -5,6 +5,7 @@ pub mod camera_rig;
 mod freeform;
 pub mod headless;
 mod mesh;
+mod panel;
 mod terrain;
 pub mod window;
 

@@ -7,11 +7,13 @@ use crate::gpu::exposure::ExposureMeter;
 use crate::gpu::timing::PassTimer;
 use crate::gpu::{BackendChoice, Gpu};
 use crate::player::camera_rig::{Fly, Held, Orbit};
+use crate::player::panel::{self, layer::Layer, script::Script, WidgetRects};
 use crate::player::{Player, PlayerOptions, Sun};
 use crate::render::camera::Camera;
 use crate::render::exposure::{self, Exposure};
 use crate::render::mesh_reference::FrameSettings;
 use crate::scene::Light;
+use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -20,6 +22,8 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
+
+mod with_panel;
 
 struct Running {
     window: Arc<Window>,
@@ -39,6 +43,16 @@ struct Running {
     /// The scene's bounding-box diagonal (the fly camera's speed scale).
     diagonal: f32,
     meter: ExposureMeter,
+    layer: Layer,
+    /// The panel is shown (`Tab` hides it).
+    panel_on: bool,
+    rects: WidgetRects,
+    /// Recent frame times (ms) and the last frame's GPU time per pass, for the panel.
+    history: VecDeque<f32>,
+    pass_ms: Vec<(&'static str, f64)>,
+    script: Script,
+    /// Screenshots written so far (their numbers).
+    shots: u32,
 }
 
 impl Running {
@@ -65,6 +79,10 @@ pub struct WindowPlan {
     pub lights: Vec<Light>,
     /// Close the window after this many frames (`--exit-after`; scripts and tests).
     pub exit_after: Option<u32>,
+    /// Scripted panel input (`--panel-script`, [`panel::script`]).
+    pub panel_script: Option<PathBuf>,
+    /// Show the panel from the start (`--no-panel` hides it; `Tab` toggles).
+    pub panel: bool,
 }
 
 struct App {
@@ -136,7 +154,9 @@ impl App {
             .unwrap_or(caps.formats[0]);
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            // Copies out of the surface serve the panel script's `window` step.
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | (caps.usages & wgpu::TextureUsages::COPY_SRC),
             format,
             width: size.width.max(1),
             height: size.height.max(1),
@@ -181,6 +201,11 @@ impl App {
         }
         let diagonal = player.diagonal();
         let meter = ExposureMeter::new(&gpu)?;
+        let layer = Layer::new(&gpu, &window, format);
+        let script = match &self.plan.panel_script {
+            Some(p) => Script::read(p)?,
+            None => Script::default(),
+        };
         Ok(Running {
             window,
             surface,
@@ -197,6 +222,13 @@ impl App {
             frame_ms: 0.0,
             diagonal,
             meter,
+            layer,
+            panel_on: self.plan.panel,
+            rects: WidgetRects::new(),
+            history: VecDeque::new(),
+            pass_ms: Vec::new(),
+            script,
+            shots: 0,
         })
     }
 
@@ -235,8 +267,45 @@ impl App {
         };
         let view = frame.texture.create_view(&Default::default());
         r.blit.draw(&r.gpu, r.player.target_view(), &view);
+        for step in r.script.due(self.frames) {
+            match step {
+                panel::script::Step::Pointer { label, pressed } => {
+                    let rect = r.rects.get(label).ok_or_else(|| {
+                        Error::knob(format!(
+                            "the panel script names `{label}`, which the panel does not show"
+                        ))
+                    })?;
+                    r.layer
+                        .injected
+                        .extend(panel::script::pointer_events(*rect, *pressed));
+                }
+                panel::script::Step::Screenshot(path) => {
+                    super::headless::write_png(path, &r.player.read_image(&r.gpu)?)?;
+                }
+                panel::script::Step::Window(_) => {}
+            }
+        }
+        if r.panel_on {
+            self.panel(&view)?;
+        }
+        let Some(r) = self.running.as_mut() else {
+            return Ok(false);
+        };
+        for step in r.script.due(self.frames) {
+            if let panel::script::Step::Window(path) = step {
+                write_surface(&r.gpu, &frame.texture, path)?;
+            }
+        }
         r.gpu.queue.present(frame);
-        r.frame_ms = 0.9 * r.frame_ms + 0.1 * t0.elapsed().as_secs_f64() * 1e3;
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        r.frame_ms = 0.9 * r.frame_ms + 0.1 * ms;
+        r.history.push_back(ms as f32);
+        if r.history.len() > 240 {
+            r.history.pop_front();
+        }
+        if r.gpu.info.timestamps {
+            r.pass_ms = r.timer.read(&r.gpu)?;
+        }
         if r.last.elapsed().as_millis() > 250 {
             r.last = Instant::now();
             let s = &self.plan.settings;
@@ -270,6 +339,10 @@ impl App {
     }
 
     fn key(&mut self, key: &Key) -> Result<bool> {
+        if *key == Key::Named(NamedKey::F12) {
+            self.screenshot()?;
+            return Ok(false);
+        }
         let Some(r) = self.running.as_mut() else {
             return Ok(false);
         };
@@ -277,11 +350,7 @@ impl App {
         if let Key::Character(c) = key {
             match c.to_ascii_lowercase().as_str() {
                 "f" => {
-                    r.fly = match r.fly {
-                        Some(_) => None,
-                        None => Some(Fly::from_camera(&r.orbit.camera(), r.diagonal)),
-                    };
-                    r.held = Held::default();
+                    self.toggle_fly();
                     return Ok(false);
                 }
                 "t" => {
@@ -294,6 +363,7 @@ impl App {
         }
         match key {
             Key::Named(NamedKey::Escape) => return Ok(true),
+            Key::Named(NamedKey::Tab) => r.panel_on = !r.panel_on,
             Key::Named(NamedKey::ArrowLeft) => r.orbit.azimuth -= 5.0,
             Key::Named(NamedKey::ArrowRight) => r.orbit.azimuth += 5.0,
             Key::Named(NamedKey::ArrowUp) => {
@@ -366,6 +436,27 @@ impl App {
     }
 }
 
+/// Write the surface texture `t` (RGBA8 or BGRA8, created with `COPY_SRC`) as a PNG.
+fn write_surface(gpu: &Gpu, t: &wgpu::Texture, path: &std::path::Path) -> Result<()> {
+    if !t.usage().contains(wgpu::TextureUsages::COPY_SRC) {
+        return Err(Error::unsupported(
+            path,
+            "this window surface cannot be copied from",
+        ));
+    }
+    let mut px = crate::gpu::readback::read_texture_4bpp(gpu, t)?;
+    if matches!(
+        t.format(),
+        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+    ) {
+        px.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+    }
+    px.chunks_exact_mut(4).for_each(|p| p[3] = 255);
+    let img = image::RgbaImage::from_raw(t.width(), t.height(), px)
+        .ok_or_else(|| Error::Internal("surface readback size".into()))?;
+    super::headless::write_png(path, &img)
+}
+
 /// Record a movement key going down or up (W A S D, Q E, Shift); other keys change nothing.
 fn hold(held: &mut Held, key: &Key, down: bool) {
     match key {
@@ -408,6 +499,26 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        // The panel sees every event first; what it uses (a click on a widget, typing in a
+        // field) does not reach the camera or the keys.
+        if let Some(r) = self.running.as_mut() {
+            let used = r.layer.on_event(&r.window, &event);
+            let input = matches!(
+                event,
+                WindowEvent::KeyboardInput { .. }
+                    | WindowEvent::MouseInput { .. }
+                    | WindowEvent::MouseWheel { .. }
+                    | WindowEvent::CursorMoved { .. }
+            );
+            let tab = matches!(&event, WindowEvent::KeyboardInput { event: k, .. }
+                if k.logical_key == Key::Named(NamedKey::Tab));
+            if r.panel_on && used && input && !tab {
+                if matches!(event, WindowEvent::CursorMoved { .. }) {
+                    self.dragging = None;
+                }
+                return;
+            }
+        }
         let result = match event {
             WindowEvent::CloseRequested => {
                 el.exit();
