@@ -149,7 +149,7 @@ pub fn next_exposure(hist: &[u32; BINS], used: f32, a: &AutoExposure) -> f32 {
 /// in stops with time constant `tau` seconds (an eye adapts in a fraction of a second to light,
 /// more slowly to the dark: `tau` is the caller's).
 pub fn smooth(current: f32, target: f32, dt: f32, tau: f32) -> f32 {
-    if !(current > 0.0) || !current.is_finite() {
+    if current.is_nan() || current <= 0.0 || current.is_infinite() {
         return target;
     }
     let k = 1.0 - (-dt.max(0.0) / tau.max(1e-3)).exp();

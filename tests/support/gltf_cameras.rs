@@ -14,9 +14,9 @@ pub fn room_with_cameras(dir: &std::path::Path) -> std::path::PathBuf {
         {"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.01}}
     ]);
     let nodes = j["nodes"].as_array_mut().unwrap();
+    let q = std::f64::consts::FRAC_1_SQRT_2;
     nodes.push(serde_json::json!({
-        "name": "view", "camera": 0, "translation": [0.5, 0.25, 1.0],
-        "rotation": [0, 0.7071067811865476, 0, 0.7071067811865476]
+        "name": "view", "camera": 0, "translation": [0.5, 0.25, 1.0], "rotation": [0, q, 0, q]
     }));
     nodes.push(serde_json::json!({"name": "plan", "camera": 1}));
     let (view, plan) = (nodes.len() - 2, nodes.len() - 1);
