@@ -140,6 +140,47 @@ pub fn write_horizon_planes(
     results.into_iter().collect()
 }
 
+/// Write the horizon angles of every azimuth of `hm` (degrees, f32) as one GeoTIFF at `path`, a
+/// band per azimuth described as `azimuth AAA.AAA deg` by its exact azimuth, with the input's
+/// georeference and no-data texels, compressed by `compress`.
+pub fn write_horizon_stack(
+    path: &Path,
+    map: &HeightMap,
+    info: &HeightMapInfo,
+    hm: &HorizonMap,
+    compress: TiffCompression,
+) -> Result<()> {
+    let band = |k: usize, texels: std::ops::Range<usize>| {
+        let plane = &hm.angles[k];
+        let nodata = NODATA as f32;
+        texels
+            .map(|i| {
+                if is_nodata(info, i) {
+                    nodata
+                } else {
+                    decode(plane[i]) as f32
+                }
+            })
+            .collect()
+    };
+    let names: Vec<String> = hm
+        .directions
+        .iter()
+        .map(|d| format!("azimuth {:.3} deg", d.azimuth_deg))
+        .collect();
+    let georef = info.georef.as_ref();
+    crate::heightmap::georef::write_geotiff_stack_f32(
+        path,
+        map.width,
+        map.height,
+        &names,
+        band,
+        georef,
+        Some(NODATA),
+        compress,
+    )
+}
+
 /// Write the shaded relief of `map` (8-bit sRGB PNG): Lambert × (k_shadow + (1 − k_shadow)·lit),
 /// `shadow` the shadowed fraction per texel (`terrain::hard::relief::shaded_relief`; the k's
 /// checked by `relief::check_k`).

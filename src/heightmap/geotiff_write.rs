@@ -6,7 +6,9 @@ use crate::error::{Error, Result};
 use std::io::{Seek, Write};
 use std::path::Path;
 use tiff::encoder::{colortype, Compression, DeflateLevel, Predictor};
-use tiff::encoder::{TiffEncoder, TiffKind, TiffKindBig, TiffKindStandard, TiffValue};
+use tiff::encoder::{
+    DirectoryEncoder, TiffEncoder, TiffKind, TiffKindBig, TiffKindStandard, TiffValue,
+};
 use tiff::tags::Tag;
 use tiff::TiffResult;
 
@@ -112,8 +114,7 @@ pub fn write_geotiff_u8_with(
     write::<colortype::Gray8>(path, [width, height], values, georef, nodata, settings)
 }
 
-/// Checks the sizes, encodes to the temporary file, syncs it and renames it onto `path`; the
-/// temporary is removed on any error.
+/// Checks the sizes and writes the GeoTIFF atomically ([`write_atomically`]).
 fn write<C: colortype::ColorType>(
     path: &Path,
     size: [usize; 2],
@@ -130,6 +131,23 @@ where
         let msg = format!("{shown}: {n} values for a {w}x{h} GeoTIFF (sides: 1 to 2^32 - 1)");
         return Err(Error::knob(msg));
     }
+    write_atomically(path, |out| {
+        let nodata = nodata.as_deref();
+        match std::mem::size_of_val(values) > 1 << 31 {
+            // BigTIFF when the offsets may pass 4 GiB
+            true => encode::<_, TiffKindBig, C>(out, size, values, georef, nodata, p),
+            false => encode::<_, TiffKindStandard, C>(out, size, values, georef, nodata, p),
+        }
+    })
+}
+
+/// Run `encode` into a temporary file beside `path` (`.NAME.relume-tmp-PID`), sync it and rename
+/// it onto `path`; the temporary is removed on any error.
+pub(super) fn write_atomically(
+    path: &Path,
+    encode: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> TiffResult<()>,
+) -> Result<()> {
+    let shown = path.display();
     let Some(name) = path.file_name() else {
         return Err(Error::knob(format!("{shown}: not a file path")));
     };
@@ -139,13 +157,7 @@ where
     let result = (|| {
         let file = std::fs::File::create(&tmp).map_err(io)?;
         let mut out = std::io::BufWriter::new(file);
-        let nodata = nodata.as_deref();
-        let encoded = match std::mem::size_of_val(values) > 1 << 31 {
-            // BigTIFF when the offsets may pass 4 GiB
-            true => encode::<_, TiffKindBig, C>(&mut out, size, values, georef, nodata, p),
-            false => encode::<_, TiffKindStandard, C>(&mut out, size, values, georef, nodata, p),
-        };
-        encoded.map_err(|e| match e {
+        encode(&mut out).map_err(|e| match e {
             tiff::TiffError::IoError(e) => io(e),
             other => Error::unsupported(path, format!("cannot encode GeoTIFF: {other}")),
         })?;
@@ -174,28 +186,38 @@ where
     enc = enc.with_compression(compression);
     let mut image = enc.new_image::<C>(w as u32, h as u32)?;
     let dir = image.encoder(); // tags written here join the image's directory
-    if let Some(g) = georef {
-        for (tag, v) in [
-            (Tag::ModelPixelScaleTag, &g.pixel_scale),
-            (Tag::ModelTiepointTag, &g.tiepoints),
-            (Tag::ModelTransformationTag, &g.transformation),
-            (Tag::GeoDoubleParamsTag, &g.geo_doubles),
-        ] {
-            if !v.is_empty() {
-                dir.write_tag(tag, &v[..])?; // [f64] is written as DOUBLE
-            }
-        }
-        if !g.geo_keys.is_empty() {
-            dir.write_tag(Tag::GeoKeyDirectoryTag, &g.geo_keys[..])?; // [u16]: SHORT
-        }
-        if !g.geo_ascii.is_empty() {
-            let ascii = |c: char| if c.is_ascii() && c != '\0' { c } else { '?' };
-            let text: String = g.geo_ascii.chars().map(ascii).collect();
-            dir.write_tag(Tag::GeoAsciiParamsTag, text.as_str())?; // str: ASCII + NUL
-        }
-    }
+    geo_tags(dir, georef)?;
     if let Some(text) = nodata {
         dir.write_tag(Tag::GdalNodata, text)?;
     }
     image.write_data(values)
+}
+
+/// Write `georef`'s GeoTIFF tags (those it has) into the directory `dir`.
+pub(super) fn geo_tags<W: Write + Seek, K: TiffKind>(
+    dir: &mut DirectoryEncoder<'_, W, K>,
+    georef: Option<&GeoReference>,
+) -> TiffResult<()> {
+    let Some(g) = georef else {
+        return Ok(());
+    };
+    for (tag, v) in [
+        (Tag::ModelPixelScaleTag, &g.pixel_scale),
+        (Tag::ModelTiepointTag, &g.tiepoints),
+        (Tag::ModelTransformationTag, &g.transformation),
+        (Tag::GeoDoubleParamsTag, &g.geo_doubles),
+    ] {
+        if !v.is_empty() {
+            dir.write_tag(tag, &v[..])?; // [f64] is written as DOUBLE
+        }
+    }
+    if !g.geo_keys.is_empty() {
+        dir.write_tag(Tag::GeoKeyDirectoryTag, &g.geo_keys[..])?; // [u16]: SHORT
+    }
+    if !g.geo_ascii.is_empty() {
+        let ascii = |c: char| if c.is_ascii() && c != '\0' { c } else { '?' };
+        let text: String = g.geo_ascii.chars().map(ascii).collect();
+        dir.write_tag(Tag::GeoAsciiParamsTag, text.as_str())?; // str: ASCII + NUL
+    }
+    Ok(())
 }

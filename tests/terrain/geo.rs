@@ -170,7 +170,8 @@ fn geotiff_masks_keep_the_georeference_and_the_nodata() {
 
 /// `--compress none|lzw|deflate|deflate-small`: rasterio (GDAL) reads every plane of every
 /// choice with the compression it names and the same values as the uncompressed file, and the
-/// shadow mask (u8, horizontal differencing) likewise.
+/// shadow mask (u8, horizontal differencing) likewise. `--stack`: one GeoTIFF whose bands are
+/// the planes (same values, georeference and no-data), described by their azimuths.
 #[test]
 fn every_geotiff_compression_reads_back_the_same_values_in_gdal() {
     if !require_python(&["rasterio", "numpy"]) {
@@ -193,6 +194,8 @@ fn every_geotiff_compression_reads_back_the_same_values_in_gdal() {
                 c,
                 "--out",
                 s(&out),
+                "--stack",
+                s(&dir.path().join(format!("stack-{c}.tif"))),
             ],
         );
         expect_code(&o, 0);
@@ -229,8 +232,18 @@ for c in ['none', 'lzw', 'deflate', 'deflate-small']:
     got = [read(p) for p in planes] + [read(os.path.join(d, 'mask-%s.tif' % c))]
     out[c] = {'names': names, 'compression': sorted({g[0] for g in got}),
               'values': [g[1] for g in got]}
+    with rasterio.open(os.path.join(d, 'stack-%s.tif' % c)) as st, rasterio.open(planes[0]) as p0:
+        bands = st.read()
+        out[c]['stack'] = {
+            'count': st.count, 'interleave': st.interleaving.value,
+            'compression': st.compression.value if st.compression else 'NONE',
+            'descriptions': list(st.descriptions), 'nodata': st.nodata,
+            'same_georef': st.crs == p0.crs and st.transform == p0.transform,
+            'same_values': all(np.array_equal(bands[k], out[c]['values'][k], equal_nan=True)
+                               for k in range(len(planes))),
+        }
 ref = out['none']['values']
-print(json.dumps({c: {'names': v['names'], 'compression': v['compression'],
+print(json.dumps({c: {'names': v['names'], 'compression': v['compression'], 'stack': v['stack'],
                       'same': all(np.array_equal(a, b, equal_nan=True) for a, b in zip(v['values'], ref))}
                   for c, v in out.items()}))
 "#;
@@ -250,5 +263,22 @@ print(json.dumps({c: {'names': v['names'], 'compression': v['compression'],
             j[c]["same"], true,
             "{c}: values differ from the uncompressed file"
         );
+        let st = &j[c]["stack"];
+        assert_eq!(st["count"], 4, "{c}: {st}");
+        assert_eq!(st["interleave"], "BAND", "{c}: {st}");
+        assert_eq!(st["compression"], method, "{c}: {st}");
+        assert_eq!(st["nodata"], -9999.0, "{c}: {st}");
+        assert_eq!(st["same_georef"], true, "{c}: {st}");
+        assert_eq!(st["same_values"], true, "{c}: {st}");
+        // horizon_AAA.AAA.tif ↔ "azimuth A.AAA deg".
+        for (name, d) in j[c]["names"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(st["descriptions"].as_array().unwrap())
+        {
+            let az: f64 = name.as_str().unwrap()[8..15].parse().unwrap();
+            assert_eq!(d.as_str().unwrap(), format!("azimuth {az:.3} deg"), "{c}");
+        }
     }
 }

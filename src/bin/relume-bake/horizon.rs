@@ -51,6 +51,10 @@ pub struct HorizonArgs {
     /// Directory for one horizon-angle GeoTIFF per azimuth (degrees, f32): horizon_AAA.AAA.tif
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// One GeoTIFF with a band per azimuth (degrees, f32; band descriptions name the azimuths),
+    /// which GDAL and rasterio read as a stack
+    #[arg(long, value_name = "STACK.tif")]
+    pub stack: Option<PathBuf>,
     /// GeoTIFF compression (none: fastest, largest; deflate-small: smallest, slowest)
     #[arg(long, value_enum, value_name = "HOW", default_value_t = DEFAULT_COMPRESS)]
     pub compress: TiffCompression,
@@ -94,9 +98,12 @@ pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i
     if let Some(p) = &args.sky_view {
         check_extension(p, &["tif", "tiff", "exr"])?;
     }
-    if args.sky_view.is_none() && args.out.is_none() {
+    if let Some(p) = &args.stack {
+        check_extension(p, &["tif", "tiff"])?;
+    }
+    if args.sky_view.is_none() && args.out.is_none() && args.stack.is_none() {
         return Err(Error::knob(
-            "nothing to write: give --sky-view SVF.tif and/or --out DIR",
+            "nothing to write: give --sky-view SVF.tif, --out DIR and/or --stack STACK.tif",
         ));
     }
     let settings = horizon_settings(args.directions, args.planet_radius);
@@ -113,6 +120,9 @@ pub fn horizon(args: &HorizonArgs, ui: &Ui, quiet: bool, json: bool) -> Result<i
     }
     if let Some(dir) = &args.out {
         rasters::write_horizon_planes(dir, &map, &info, &hm, args.compress)?;
+    }
+    if let Some(p) = &args.stack {
+        rasters::write_horizon_stack(p, &map, &info, &hm, args.compress)?;
     }
     if json {
         print_json(&json!({
