@@ -2,7 +2,7 @@
 //! player's one-shot headless exposure against the log-average of its own frame computed here
 //! without the histogram.
 
-use crate::common::{bake, data, expect_code, gpu};
+use crate::common::{expect_code, gpu};
 use relume::gpu::exposure::ExposureMeter;
 use relume::render::exposure::{histogram, BINS, LOG2_MAX, LOG2_MIN, SETTLED_EV};
 use wgpu::util::DeviceExt;
@@ -92,18 +92,7 @@ fn headless_auto_exposure_is_the_log_average_of_its_frame() {
         return;
     }
     let tmp = tempfile::tempdir().unwrap();
-    let baked = tmp.path().join("bake");
-    let o = bake(
-        tmp.path(),
-        &[
-            "run",
-            "-q",
-            data("pipelines/cornell.ron").to_str().unwrap(),
-            "--out",
-            baked.to_str().unwrap(),
-        ],
-    );
-    expect_code(&o, 0);
+    let baked = crate::player::bake_pipeline(tmp.path(), "pipelines/cornell.ron");
     let render = |name: &str, extra: &[&str]| {
         let out = tmp.path().join(name);
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_relume-player"))

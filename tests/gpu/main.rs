@@ -21,6 +21,7 @@ mod gather;
 mod kernels;
 mod layout;
 mod player;
+mod player_ui;
 mod terrain;
 mod terrain_air;
 mod textures;

@@ -293,7 +293,7 @@ impl App {
         };
         for step in r.script.due(self.frames) {
             if let panel::script::Step::Window(path) = step {
-                write_surface(&r.gpu, &frame.texture, path)?;
+                with_panel::write_surface(&r.gpu, &frame.texture, path)?;
             }
         }
         r.gpu.queue.present(frame);
@@ -434,27 +434,6 @@ impl App {
         }
         Ok(false)
     }
-}
-
-/// Write the surface texture `t` (RGBA8 or BGRA8, created with `COPY_SRC`) as a PNG.
-fn write_surface(gpu: &Gpu, t: &wgpu::Texture, path: &std::path::Path) -> Result<()> {
-    if !t.usage().contains(wgpu::TextureUsages::COPY_SRC) {
-        return Err(Error::unsupported(
-            path,
-            "this window surface cannot be copied from",
-        ));
-    }
-    let mut px = crate::gpu::readback::read_texture_4bpp(gpu, t)?;
-    if matches!(
-        t.format(),
-        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
-    ) {
-        px.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
-    }
-    px.chunks_exact_mut(4).for_each(|p| p[3] = 255);
-    let img = image::RgbaImage::from_raw(t.width(), t.height(), px)
-        .ok_or_else(|| Error::Internal("surface readback size".into()))?;
-    super::headless::write_png(path, &img)
 }
 
 /// Record a movement key going down or up (W A S D, Q E, Shift); other keys change nothing.

@@ -4,6 +4,7 @@
 
 use super::App;
 use crate::error::{Error, Result};
+use crate::gpu::Gpu;
 use crate::player::camera_rig::Fly;
 use crate::player::panel::{self, Changes, PanelView};
 use crate::player::Player;
@@ -109,4 +110,25 @@ impl App {
         eprintln!("screenshot: {}", path.display());
         Ok(())
     }
+}
+
+/// Write the surface texture `t` (RGBA8 or BGRA8, created with `COPY_SRC`) as a PNG.
+pub(super) fn write_surface(gpu: &Gpu, t: &wgpu::Texture, path: &std::path::Path) -> Result<()> {
+    if !t.usage().contains(wgpu::TextureUsages::COPY_SRC) {
+        return Err(Error::unsupported(
+            path,
+            "this window surface cannot be copied from",
+        ));
+    }
+    let mut px = crate::gpu::readback::read_texture_4bpp(gpu, t)?;
+    if matches!(
+        t.format(),
+        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+    ) {
+        px.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+    }
+    px.chunks_exact_mut(4).for_each(|p| p[3] = 255);
+    let img = image::RgbaImage::from_raw(t.width(), t.height(), px)
+        .ok_or_else(|| Error::Internal("surface readback size".into()))?;
+    super::super::headless::write_png(path, &img)
 }
