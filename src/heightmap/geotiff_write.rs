@@ -23,6 +23,9 @@ use tiff::TiffResult;
 /// | `lzw` | 1.17–1.25 s | 62.3 MiB |
 /// | `deflate` (default) | 0.79–0.81 s | 41.1 MiB |
 /// | `deflate-small` | 1.62–1.71 s | 33.9 MiB |
+///
+/// `zstd` (written by `geotiff_stack`): 0.77 s and 52 MiB in a later pair of runs where `none`
+/// took 0.68 s and `deflate` 0.90 s (docs/terrain.md has those and the 2K numbers).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum TiffCompression {
@@ -35,15 +38,19 @@ pub enum TiffCompression {
     Deflate,
     /// Deflate at zlib's balanced level: a fifth smaller than `deflate`, twice the time.
     DeflateSmall,
+    /// Zstandard at level 1 (GDAL's compression 50000; GDAL, rasterio and QGIS read it).
+    Zstd,
 }
 
 impl TiffCompression {
-    fn method(self) -> Compression {
+    /// The tiff crate's codec, None for those written by `geotiff_stack` (zstd).
+    fn method(self) -> Option<Compression> {
         match self {
-            TiffCompression::None => Compression::Uncompressed,
-            TiffCompression::Lzw => Compression::Lzw,
-            TiffCompression::Deflate => Compression::Deflate(DeflateLevel::Fast),
-            TiffCompression::DeflateSmall => Compression::Deflate(DeflateLevel::Balanced),
+            TiffCompression::None => Some(Compression::Uncompressed),
+            TiffCompression::Lzw => Some(Compression::Lzw),
+            TiffCompression::Deflate => Some(Compression::Deflate(DeflateLevel::Fast)),
+            TiffCompression::DeflateSmall => Some(Compression::Deflate(DeflateLevel::Balanced)),
+            TiffCompression::Zstd => None,
         }
     }
 }
@@ -75,10 +82,13 @@ pub fn write_geotiff_f32_with(
     nodata: Option<f64>,
     compression: TiffCompression,
 ) -> Result<()> {
+    let Some(method) = compression.method() else {
+        return write_one_band(path, [width, height], values, georef, nodata, compression);
+    };
     // The shortest decimal that reads back the same ("-9999", "NaN", "inf"; never an exponent).
     let nodata = nodata.map(|v| v.to_string());
     let p = Predictor::None; // tiff 0.10 cannot write the floating-point predictor
-    let settings = (p, compression.method());
+    let settings = (p, method);
     write::<colortype::Gray32Float>(path, [width, height], values, georef, nodata, settings)
 }
 
@@ -106,12 +116,35 @@ pub fn write_geotiff_u8_with(
     nodata: Option<u8>,
     compression: TiffCompression,
 ) -> Result<()> {
+    let Some(method) = compression.method() else {
+        let nodata = nodata.map(f64::from);
+        return write_one_band(path, [width, height], values, georef, nodata, compression);
+    };
     let p = match compression {
         TiffCompression::None => Predictor::None,
         _ => Predictor::Horizontal,
     };
-    let (nodata, settings) = (nodata.map(|v| v.to_string()), (p, compression.method()));
+    let (nodata, settings) = (nodata.map(|v| v.to_string()), (p, method));
     write::<colortype::Gray8>(path, [width, height], values, georef, nodata, settings)
+}
+
+/// A single-band raster through the band writer (`geotiff_stack`), for the codecs the tiff
+/// crate lacks.
+fn write_one_band<T: super::geotiff_stack::Sample>(
+    path: &Path,
+    [w, h]: [usize; 2],
+    values: &[T],
+    georef: Option<&GeoReference>,
+    nodata: Option<f64>,
+    compression: TiffCompression,
+) -> Result<()> {
+    let (n, shown) = (values.len(), path.display());
+    if w.checked_mul(h) != Some(n) {
+        let msg = format!("{shown}: {n} values for a {w}x{h} GeoTIFF (sides: 1 to 2^32 - 1)");
+        return Err(Error::knob(msg));
+    }
+    let band = |_: usize, texels: std::ops::Range<usize>| values[texels].to_vec();
+    super::geotiff_stack::write_bands(path, [w, h], (1, None), band, georef, nodata, compression)
 }
 
 /// Checks the sizes and writes the GeoTIFF atomically ([`write_atomically`]).

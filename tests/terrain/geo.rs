@@ -168,7 +168,7 @@ fn geotiff_masks_keep_the_georeference_and_the_nodata() {
     assert!((frac - reported).abs() < 1e-12, "{frac} vs {reported}");
 }
 
-/// `--compress none|lzw|deflate|deflate-small`: rasterio (GDAL) reads every plane of every
+/// `--compress none|lzw|deflate|deflate-small|zstd`: rasterio (GDAL) reads every plane of every
 /// choice with the compression it names and the same values as the uncompressed file, and the
 /// shadow mask (u8, horizontal differencing) likewise. `--stack`: one GeoTIFF whose bands are
 /// the planes (same values, georeference and no-data), described by their azimuths.
@@ -179,7 +179,7 @@ fn every_geotiff_compression_reads_back_the_same_values_in_gdal() {
     }
     let dir = tempfile::tempdir().unwrap();
     let srtm = data("scenes/dem/srtm_bigtujunga_30m.tif");
-    let choices = ["none", "lzw", "deflate", "deflate-small"];
+    let choices = ["none", "lzw", "deflate", "deflate-small", "zstd"];
     for c in choices {
         let out = dir.path().join(c);
         let o = bake(
@@ -226,7 +226,7 @@ def read(p):
     with rasterio.open(p) as s:
         return (s.compression.value if s.compression else 'NONE'), s.read(1)
 out = {}
-for c in ['none', 'lzw', 'deflate', 'deflate-small']:
+for c in ['none', 'lzw', 'deflate', 'deflate-small', 'zstd']:
     planes = sorted(glob.glob(os.path.join(d, c, 'horizon_*.tif')))
     names = [os.path.basename(p) for p in planes]
     got = [read(p) for p in planes] + [read(os.path.join(d, 'mask-%s.tif' % c))]
@@ -254,6 +254,7 @@ print(json.dumps({c: {'names': v['names'], 'compression': v['compression'], 'sta
         ("lzw", "LZW"),
         ("deflate", "DEFLATE"),
         ("deflate-small", "DEFLATE"),
+        ("zstd", "ZSTD"),
     ];
     for (c, method) in want {
         assert_eq!(j[c]["names"].as_array().unwrap().len(), 4, "{c}: {j}");
