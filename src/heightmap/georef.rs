@@ -11,10 +11,10 @@ use std::io::{Read, Seek};
 use std::path::Path;
 use tiff::decoder::{ifd::Value, Decoder};
 
+pub use super::geotiff_common::TiffCompression;
 pub use super::geotiff_stack::write_geotiff_stack_f32;
 pub use super::geotiff_write::{
     write_geotiff_f32, write_geotiff_f32_with, write_geotiff_u8, write_geotiff_u8_with,
-    TiffCompression,
 };
 use tiff::tags::Tag;
 use tiff::TiffResult;

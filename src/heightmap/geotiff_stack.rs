@@ -12,7 +12,7 @@
 //! thread count. Written atomically like every GeoTIFF of relume (temporary file, sync, rename).
 
 use super::georef::GeoReference;
-use super::geotiff_write::{geo_tags, TiffCompression};
+use super::geotiff_common::{geo_tags, write_atomically, TiffCompression};
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::io::{Seek, Write};
@@ -110,7 +110,7 @@ pub(super) fn write_bands<T: Sample>(
     let metadata = names.map(gdal_metadata);
     let nodata = nodata.map(|v| v.to_string());
     let total: usize = strips.iter().map(Vec::len).sum();
-    super::geotiff_write::write_atomically(path, |out| {
+    write_atomically(path, |out| {
         let d = Layout {
             size: [width as u32, height as u32],
             bands: count as u16,

@@ -11,6 +11,7 @@
 //! by default, or filled with the minimum valid height or with the nearest valid height.
 
 pub mod georef;
+mod geotiff_common;
 mod geotiff_stack;
 mod geotiff_write;
 pub mod minmax_mipmap;
