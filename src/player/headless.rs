@@ -83,7 +83,9 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
             player.set_sun(gpu, plan.sun.map(|s| sun_of_frame(s, 0, plan.frames)))?;
             player.set_phase(0.0);
             player.set_frame(gpu, 0, &settings);
-            let (e, tries) = find_exposure(gpu, &mut player, &camera, &settings, &a, &mut timer)?;
+            let meter = ExposureMeter::new(gpu)?;
+            let (e, tries) =
+                find_exposure(gpu, &mut player, &meter, &camera, &settings, &a, &mut timer)?;
             settings.exposure = e;
             ("auto", Some(tries))
         }
@@ -135,18 +137,18 @@ pub fn render_frames(gpu: &Gpu, plan: &HeadlessPlan) -> Result<HeadlessReport> {
 pub fn find_exposure(
     gpu: &Gpu,
     player: &mut Player,
+    meter: &ExposureMeter,
     camera: &Camera,
     s: &FrameSettings,
     auto: &AutoExposure,
     timer: &mut PassTimer,
 ) -> Result<(f32, usize)> {
-    let meter = ExposureMeter::new(gpu)?;
     let mut s = *s;
     for tries in 1..=exposure::MAX_TRIES {
         player.render(gpu, camera, &s, timer)?;
         timer.read(gpu)?;
         let next =
-            exposure::next_exposure(&player.exposure_histogram(gpu, &meter)?, s.exposure, auto);
+            exposure::next_exposure(&player.exposure_histogram(gpu, meter)?, s.exposure, auto);
         if (next / s.exposure).log2().abs() <= exposure::SETTLED_EV {
             return Ok((s.exposure, tries));
         }

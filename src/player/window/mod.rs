@@ -184,6 +184,7 @@ impl App {
         let orbit = Orbit::from_camera(&camera);
         let blit = Blit::new(&gpu, format)?;
         let mut timer = PassTimer::new(&gpu, 48);
+        let meter = ExposureMeter::new(&gpu)?;
         match self.plan.exposure {
             Exposure::Fixed(e) => self.plan.settings.exposure = e,
             Exposure::Auto(a) => {
@@ -191,6 +192,7 @@ impl App {
                 let (e, _) = super::headless::find_exposure(
                     &gpu,
                     &mut player,
+                    &meter,
                     &camera,
                     &self.plan.settings,
                     &a,
@@ -200,7 +202,6 @@ impl App {
             }
         }
         let diagonal = player.diagonal();
-        let meter = ExposureMeter::new(&gpu)?;
         let layer = Layer::new(&gpu, &window, format);
         let script = match &self.plan.panel_script {
             Some(p) => Script::read(p)?,
